@@ -1,0 +1,66 @@
+# Helper functions that keep the per-folder CMake files small.
+
+set(SKELGRAPH_WARNINGS -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor)
+
+# skelgraph_library(NAME SOURCES ... [DEPS ...] [PUBLIC_INCLUDE dir])
+# A static library with the project's warnings and its include/ folder public.
+function(skelgraph_library name)
+  cmake_parse_arguments(A "" "" "SOURCES;DEPS" ${ARGN})
+  add_library(${name} STATIC ${A_SOURCES})
+  target_include_directories(${name} PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/include)
+  target_compile_options(${name} PRIVATE ${SKELGRAPH_WARNINGS})
+  target_link_libraries(${name} PUBLIC ${A_DEPS})
+  set_target_properties(${name} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+endfunction()
+
+# skelgraph_component(KIND kind CORE core_target ADAPTER_SOURCES ... [DEPS ...])
+# The adapter library of a component; KIND is the name launch files use. The
+# adapter's .cpp ends with SKELGRAPH_REGISTER_COMPONENT(kind, Class); the
+# program's registry is generated from the list collected here.
+function(skelgraph_component)
+  cmake_parse_arguments(A "" "KIND;TARGET" "SOURCES;DEPS" ${ARGN})
+  skelgraph_library(${A_TARGET} SOURCES ${A_SOURCES} DEPS skelgraph_runtime ${A_DEPS})
+  set_property(GLOBAL APPEND PROPERTY SKELGRAPH_COMPONENT_KINDS ${A_KIND})
+  set_property(GLOBAL APPEND PROPERTY SKELGRAPH_COMPONENT_TARGETS ${A_TARGET})
+endfunction()
+
+# skelgraph_test(NAME SOURCES ... [DEPS ...] [DDS] [LABELS ...])
+# A GoogleTest executable registered with ctest. DDS tests run in a private
+# network namespace with only `lo` (tests/netns-lo.sh), on their own domain id.
+set_property(GLOBAL PROPERTY SKELGRAPH_NEXT_TEST_DOMAIN 10)
+function(skelgraph_test name)
+  cmake_parse_arguments(A "DDS" "" "SOURCES;DEPS;LABELS" ${ARGN})
+  add_executable(${name} ${A_SOURCES})
+  target_compile_options(${name} PRIVATE ${SKELGRAPH_WARNINGS})
+  target_link_libraries(${name} PRIVATE ${A_DEPS} GTest::gtest GTest::gtest_main)
+  set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/tests)
+  if(A_DDS)
+    skelgraph_next_domain(domain)
+    add_test(NAME ${name} COMMAND ${PROJECT_SOURCE_DIR}/tests/netns-lo.sh $<TARGET_FILE:${name}>)
+    set_tests_properties(${name} PROPERTIES
+      ENVIRONMENT "SKELGRAPH_DOMAIN=${domain};SKELGRAPH_SOURCE_DIR=${PROJECT_SOURCE_DIR}"
+      LABELS "${A_LABELS}" TIMEOUT 300)
+  else()
+    add_test(NAME ${name} COMMAND ${name})
+    set_tests_properties(${name} PROPERTIES
+      ENVIRONMENT "SKELGRAPH_SOURCE_DIR=${PROJECT_SOURCE_DIR}" LABELS "${A_LABELS}" TIMEOUT 300)
+  endif()
+endfunction()
+
+# skelgraph_script_test(NAME SCRIPT ... ) — a shell test in its own loopback namespace.
+function(skelgraph_script_test name script)
+  skelgraph_next_domain(domain)
+  add_test(NAME ${name}
+    COMMAND ${PROJECT_SOURCE_DIR}/tests/netns-lo.sh bash ${script} $<TARGET_FILE:skelgraph>)
+  set_tests_properties(${name} PROPERTIES
+    ENVIRONMENT "SKELGRAPH_DOMAIN=${domain};SKELGRAPH_SOURCE_DIR=${PROJECT_SOURCE_DIR}"
+    LABELS "integration" TIMEOUT 300)
+endfunction()
+
+# Hands out a distinct DDS domain id per test so tests can run in parallel.
+function(skelgraph_next_domain out)
+  get_property(d GLOBAL PROPERTY SKELGRAPH_NEXT_TEST_DOMAIN)
+  math(EXPR next "${d} + 1")
+  set_property(GLOBAL PROPERTY SKELGRAPH_NEXT_TEST_DOMAIN ${next})
+  set(${out} ${d} PARENT_SCOPE)
+endfunction()

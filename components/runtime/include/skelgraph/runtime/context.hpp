@@ -1,0 +1,93 @@
+#pragma once
+// A component's window on DDS: one DomainParticipant named after the component,
+// created from an XML profile, plus the executor that runs the component's
+// callbacks and the counters its status reports.
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "skelgraph/runtime/dds_config.hpp"
+#include "skelgraph/runtime/executor.hpp"
+
+namespace eprosima::fastdds::dds {
+class DataWriter;
+class DomainParticipant;
+class DomainParticipantListener;
+class Publisher;
+class Subscriber;
+class Topic;
+class TopicDataType;
+}  // namespace eprosima::fastdds::dds
+
+namespace skelgraph::runtime {
+
+// Counts of one input or output, shared between the endpoint and the status report.
+struct EndpointCounter {
+  std::string topic;
+  bool is_output = false;
+  std::atomic<std::uint64_t> count{0};
+  std::atomic<std::uint64_t> dropped{0};
+};
+
+enum class HealthState { Ok, Degraded, Error };
+
+class Context {
+ public:
+  // Throws std::runtime_error with the profile and domain if DDS refuses.
+  // `listener` (optional, not owned) gets discovery callbacks from the start.
+  Context(std::string name, const DdsConfig& config,
+          eprosima::fastdds::dds::DomainParticipantListener* listener = nullptr);
+  ~Context();
+  Context(const Context&) = delete;
+  Context& operator=(const Context&) = delete;
+
+  const std::string& name() const { return name_; }
+  const DdsConfig& config() const { return config_; }
+  Executor& executor() { return executor_; }
+  eprosima::fastdds::dds::DomainParticipant& participant() { return *participant_; }
+
+  // Wall-clock time in ns since the Unix epoch: message stamps.
+  static std::int64_t now_ns();
+
+  // Shared DDS entities, created on first use.
+  eprosima::fastdds::dds::Publisher& publisher();
+  eprosima::fastdds::dds::Subscriber& subscriber();
+  // Registers the type if needed (takes ownership of `support`) and returns the
+  // topic; throws if the name is already bound to another type.
+  eprosima::fastdds::dds::Topic& topic(const std::string& name, eprosima::fastdds::dds::TopicDataType* support);
+
+  std::shared_ptr<EndpointCounter> add_counter(const std::string& topic, bool is_output);
+
+  // Reliable writers register here so flush() can wait until readers have
+  // everything (used at shutdown, so a final STOP is not lost).
+  void track_reliable_writer(eprosima::fastdds::dds::DataWriter* w);
+  void untrack_reliable_writer(eprosima::fastdds::dds::DataWriter* w);
+  bool flush(std::chrono::milliseconds timeout);
+  std::vector<std::shared_ptr<EndpointCounter>> counters() const;
+
+  // The component's health, reported on skelgraph/status.
+  void set_health(HealthState state, std::string message);
+  std::pair<HealthState, std::string> health() const;
+
+ private:
+  std::string name_;
+  DdsConfig config_;
+  eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
+  eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
+  eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
+  std::map<std::string, eprosima::fastdds::dds::Topic*> topics_;
+  mutable std::mutex mutex_;
+  std::vector<std::shared_ptr<EndpointCounter>> counters_;
+  std::vector<eprosima::fastdds::dds::DataWriter*> reliable_writers_;
+  HealthState health_ = HealthState::Ok;
+  std::string health_message_;
+  Executor executor_;
+};
+
+}  // namespace skelgraph::runtime

@@ -1,0 +1,33 @@
+#pragma once
+// How a process joins DDS: which XML profile, which domain, which interfaces.
+
+#include <string>
+#include <vector>
+
+namespace skelgraph::runtime {
+
+struct DdsConfig {
+  // A profile name (bringup/profiles/<name>.xml, participant profile <name>)
+  // or a path to an XML file whose participant profile has the file's stem as name.
+  std::string profile = "loopback";
+  int domain = 0;
+  // UDP interfaces to use (lan); empty keeps what the profile says.
+  std::vector<std::string> interfaces;
+  // Reported in status messages and sync acks.
+  std::string host;
+
+  // Defaults from the environment: SKELGRAPH_PROFILE, SKELGRAPH_DOMAIN,
+  // SKELGRAPH_INTERFACES (comma-separated), SKELGRAPH_HOST (else the host name).
+  // Throws std::runtime_error on a malformed value.
+  static DdsConfig from_env();
+};
+
+// Directory holding the profile XML files: $SKELGRAPH_PROFILES_DIR, else the
+// source tree's bringup/profiles (the build-tree program), else ./bringup/profiles.
+std::string profiles_dir();
+// The XML file for a profile name or path; throws std::runtime_error if absent.
+std::string profile_file(const std::string& profile);
+// The participant profile name inside that file.
+std::string profile_name(const std::string& profile);
+
+}  // namespace skelgraph::runtime

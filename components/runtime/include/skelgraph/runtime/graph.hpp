@@ -1,0 +1,59 @@
+#pragma once
+// A set of components composed in one process: each gets its own Context
+// (DomainParticipant + executor) and reports ComponentStatus once a second.
+// Used by `skelgraph launch`, the demo and the component tests alike.
+
+#include <chrono>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "skelgraph/runtime/dds_config.hpp"
+#include "skelgraph/runtime/launch_file.hpp"
+#include "skelgraph/runtime/registry.hpp"
+
+namespace skelgraph::runtime {
+
+class Component;
+class Context;
+
+struct NodeReport {
+  std::string name;
+  std::string kind;
+  std::string state;    // OK / DEGRADED / ERROR
+  std::string message;
+  std::string summary;  // the component's own line
+  std::string io;       // "out skelgraph/sync 181, in ... " counts
+};
+
+class Graph {
+ public:
+  Graph(const ComponentRegistry& registry, DdsConfig config,
+        std::chrono::milliseconds status_period = std::chrono::seconds(1));
+  ~Graph();
+  Graph(const Graph&) = delete;
+  Graph& operator=(const Graph&) = delete;
+
+  // Creates the component (its constructor runs here; exceptions propagate
+  // with the component's name prepended).
+  Component& add(const std::string& name, const std::string& kind, const Params& params);
+  void add_all(const std::vector<ResolvedComponent>& components);
+
+  void start();  // starts every executor, then on_start() of each component
+  void stop();   // on_shutdown() of each (reverse order), then stops executors; idempotent
+
+  std::vector<NodeReport> report() const;
+  Context& context(const std::string& name);
+  Component& component(const std::string& name);
+
+ private:
+  struct Node;
+  const ComponentRegistry& registry_;
+  DdsConfig config_;
+  std::chrono::milliseconds status_period_;
+  std::vector<std::unique_ptr<Node>> nodes_;
+  bool started_ = false;
+  bool stopped_ = false;
+};
+
+}  // namespace skelgraph::runtime

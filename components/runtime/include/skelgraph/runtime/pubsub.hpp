@@ -1,0 +1,119 @@
+#pragma once
+// RAII DDS endpoints typed by the wire types. Readers deliver samples on the
+// component's executor thread; writers and readers count what passes for the
+// status report. Destroying one removes its DDS entity.
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "skelgraph/msg/messages.hpp"
+#include "skelgraph/msg/raw_type.hpp"
+#include "skelgraph/runtime/context.hpp"
+#include "skelgraph/runtime/topics.hpp"
+
+namespace eprosima::fastdds::dds {
+class DataWriter;
+}
+
+namespace skelgraph::runtime {
+
+struct SampleMeta {
+  std::int64_t source_stamp_ns = 0;  // writer's clock when written
+  std::int64_t receive_ns = 0;       // our wall clock when taken
+};
+
+// Untyped halves; use Publisher<T>, Subscription<T> or RawSubscription.
+class WriterBase {
+ public:
+  WriterBase(Context& ctx, const std::string& topic, eprosima::fastdds::dds::TopicDataType* support,
+             const QosPreset& qos);
+  ~WriterBase();
+  WriterBase(const WriterBase&) = delete;
+  WriterBase& operator=(const WriterBase&) = delete;
+  bool write(void* sample);
+  std::size_t matched() const;
+  bool wait_for_matched(std::size_t n, std::chrono::milliseconds timeout) const;
+  // Reliable writers: waits until every matched reader acknowledged.
+  bool wait_for_acks(std::chrono::milliseconds timeout);
+
+ private:
+  struct Listener;
+  Context& ctx_;
+  QosPreset qos_;
+  std::unique_ptr<Listener> listener_;
+  eprosima::fastdds::dds::DataWriter* writer_ = nullptr;
+  std::shared_ptr<EndpointCounter> counter_;
+};
+
+class ReaderBase {
+ public:
+  using Deliver = std::function<void(void* sample, const SampleMeta&)>;
+  ReaderBase(Context& ctx, const std::string& topic, eprosima::fastdds::dds::TopicDataType* support,
+             const QosPreset& qos, Deliver deliver);
+  ~ReaderBase();
+  ReaderBase(const ReaderBase&) = delete;
+  ReaderBase& operator=(const ReaderBase&) = delete;
+  std::size_t matched() const;
+  bool wait_for_matched(std::size_t n, std::chrono::milliseconds timeout) const;
+
+  struct State;
+
+ private:
+  std::shared_ptr<State> state_;
+};
+
+template <class T>
+class Publisher {
+ public:
+  Publisher(Context& ctx, const TopicDef<T>& topic)
+      : base_(ctx, topic.name, new typename msg::MessageTraits<T>::PubSubType(), topic.qos) {}
+  bool publish(const T& sample) { return base_.write(const_cast<T*>(&sample)); }
+  std::size_t matched() const { return base_.matched(); }
+  bool wait_for_matched(std::size_t n, std::chrono::milliseconds timeout) const {
+    return base_.wait_for_matched(n, timeout);
+  }
+  bool wait_for_acks(std::chrono::milliseconds timeout) { return base_.wait_for_acks(timeout); }
+
+ private:
+  WriterBase base_;
+};
+
+template <class T>
+class Subscription {
+ public:
+  using Callback = std::function<void(const T&, const SampleMeta&)>;
+  Subscription(Context& ctx, const TopicDef<T>& topic, Callback cb)
+      : base_(ctx, topic.name, new typename msg::MessageTraits<T>::PubSubType(), topic.qos,
+              [cb = std::move(cb)](void* s, const SampleMeta& m) { cb(*static_cast<const T*>(s), m); }) {}
+  std::size_t matched() const { return base_.matched(); }
+  bool wait_for_matched(std::size_t n, std::chrono::milliseconds timeout) const {
+    return base_.wait_for_matched(n, timeout);
+  }
+
+ private:
+  ReaderBase base_;
+};
+
+// Receives any topic as serialized CDR, without knowing its type.
+class RawSubscription {
+ public:
+  using Callback = std::function<void(const msg::RawSample&, const SampleMeta&)>;
+  RawSubscription(Context& ctx, const std::string& topic, const std::string& type_name, bool keyed,
+                  const QosPreset& qos, Callback cb)
+      : base_(ctx, topic, new msg::RawPubSubType(type_name, keyed), qos,
+              [cb = std::move(cb)](void* s, const SampleMeta& m) {
+                cb(*static_cast<const msg::RawSample*>(s), m);
+              }) {}
+  std::size_t matched() const { return base_.matched(); }
+  bool wait_for_matched(std::size_t n, std::chrono::milliseconds timeout) const {
+    return base_.wait_for_matched(n, timeout);
+  }
+
+ private:
+  ReaderBase base_;
+};
+
+}  // namespace skelgraph::runtime

@@ -1,0 +1,36 @@
+#pragma once
+// Rate and period statistics over a sliding time window, from arrival times
+// passed in (no clock inside). Used by `topic hz`, status reports and tests.
+
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+
+namespace skelgraph::runtime {
+
+struct RateSummary {
+  std::size_t samples = 0;   // arrivals inside the window
+  double rate_hz = 0.0;      // (samples - 1) / (last - first)
+  double mean_period_s = 0.0;
+  double min_period_s = 0.0;
+  double max_period_s = 0.0;
+  double std_period_s = 0.0;
+};
+
+class RateStats {
+ public:
+  // window_ns <= 0 keeps every arrival.
+  explicit RateStats(std::int64_t window_ns = 0) : window_ns_(window_ns) {}
+  void add(std::int64_t t_ns);
+  // Drops arrivals older than the window before `now_ns`.
+  void expire(std::int64_t now_ns);
+  RateSummary summary() const;
+  std::uint64_t total() const { return total_; }
+
+ private:
+  std::int64_t window_ns_;
+  std::deque<std::int64_t> times_;
+  std::uint64_t total_ = 0;
+};
+
+}  // namespace skelgraph::runtime

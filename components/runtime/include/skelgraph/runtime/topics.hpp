@@ -1,0 +1,59 @@
+#pragma once
+// Every topic name, its wire type and its QoS, in one place.
+
+#include <string>
+#include <vector>
+
+#include "skelgraph/msg/messages.hpp"
+
+namespace skelgraph::runtime {
+
+enum class Reliability { BestEffort, Reliable };
+enum class Durability { Volatile, TransientLocal };
+
+struct QosPreset {
+  Reliability reliability = Reliability::Reliable;
+  Durability durability = Durability::Volatile;
+  int depth = 0;  // history depth per instance; 0 = keep all
+};
+
+// A topic bound to its wire type at compile time.
+template <class T>
+struct TopicDef {
+  const char* name;
+  QosPreset qos;
+};
+
+namespace topics {
+
+using R = Reliability;
+using D = Durability;
+
+// START / TICK / STOP as they happen (reliable, nothing dropped).
+inline const TopicDef<msg::SyncCommand> kSync{"skelgraph/sync", {R::Reliable, D::Volatile, 0}};
+// The latest START or STOP only, kept for late joiners (transient-local). A
+// separate topic because keeping ticks for late joiners would replay them.
+inline const TopicDef<msg::SyncCommand> kSyncSession{"skelgraph/sync/session", {R::Reliable, D::TransientLocal, 1}};
+// Requests to the sync master (skelgraph sync start|stop, robots).
+inline const TopicDef<msg::SyncControl> kSyncControl{"skelgraph/sync/control", {R::Reliable, D::Volatile, 0}};
+inline const TopicDef<msg::SyncAck> kSyncAck{"skelgraph/sync_ack", {R::Reliable, D::Volatile, 0}};
+inline const TopicDef<msg::Skeleton> kSkeletonRaw{"skelgraph/skeleton/raw", {R::BestEffort, D::Volatile, 5}};
+inline const TopicDef<msg::Skeleton> kSkeletonFused{"skelgraph/skeleton/fused", {R::BestEffort, D::Volatile, 5}};
+inline const TopicDef<msg::Skeleton> kSkeletonTruth{"skelgraph/skeleton/truth", {R::Reliable, D::Volatile, 64}};
+inline const TopicDef<msg::DepthFrame> kDepth{"skelgraph/depth", {R::BestEffort, D::Volatile, 2}};
+inline const TopicDef<msg::SensorPose> kCalibration{"skelgraph/calibration", {R::Reliable, D::TransientLocal, 1}};
+inline const TopicDef<msg::GestureEvent> kGestureEvent{"skelgraph/gesture/event", {R::Reliable, D::Volatile, 0}};
+inline const TopicDef<msg::ComponentStatus> kStatus{"skelgraph/status", {R::BestEffort, D::Volatile, 1}};
+
+}  // namespace topics
+
+// The same table, untyped, for tools that start from a topic name.
+struct TopicInfo {
+  std::string name;
+  std::string type_name;
+  QosPreset qos;
+};
+const std::vector<TopicInfo>& known_topics();
+const TopicInfo* find_topic(const std::string& name);
+
+}  // namespace skelgraph::runtime

@@ -1,0 +1,17 @@
+#pragma once
+// What type information our endpoints announce during discovery. One place,
+// because it decides both whether DDS tools can show our types and whether a
+// Fast DDS 2.9 peer survives discovering them (see docs/type-information.md).
+
+namespace eprosima::fastdds::dds {
+class TopicDataType;
+}
+
+namespace skelgraph::runtime {
+
+// Registers the generated TypeObjects with Fast DDS's TypeObjectFactory (once).
+void register_type_objects();
+// Sets what `support` announces; called for every type a Context registers.
+void apply_type_policy(eprosima::fastdds::dds::TopicDataType& support);
+
+}  // namespace skelgraph::runtime

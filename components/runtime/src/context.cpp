@@ -1,0 +1,178 @@
+#include "skelgraph/runtime/context.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <set>
+#include <stdexcept>
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/Topic.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+#include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
+
+#include "skelgraph/runtime/type_policy.hpp"
+
+namespace skelgraph::runtime {
+
+namespace dds = eprosima::fastdds::dds;
+
+namespace {
+
+// Fast DDS keeps loaded profiles in its factory (a process-wide singleton of
+// its own); load each file once.
+void load_profile_file(const std::string& file) {
+  static std::mutex mutex;
+  static std::set<std::string> loaded;
+  std::lock_guard<std::mutex> lock(mutex);
+  if (loaded.count(file) != 0) return;
+  if (dds::DomainParticipantFactory::get_instance()->load_XML_profiles_file(file) != ReturnCode_t::RETCODE_OK) {
+    throw std::runtime_error("DDS profile file " + file + " could not be loaded (see the Fast DDS error above)");
+  }
+  loaded.insert(file);
+}
+
+}  // namespace
+
+Context::Context(std::string name, const DdsConfig& config, dds::DomainParticipantListener* listener)
+    : name_(std::move(name)), config_(config), executor_(name_) {
+  register_type_objects();
+  const auto file = profile_file(config.profile);
+  const auto profile = profile_name(config.profile);
+  load_profile_file(file);
+  auto* factory = dds::DomainParticipantFactory::get_instance();
+  dds::DomainParticipantQos qos;
+  if (factory->get_participant_qos_from_profile(profile, qos) != ReturnCode_t::RETCODE_OK) {
+    throw std::runtime_error("DDS profile file " + file + " has no participant profile named '" + profile + "'");
+  }
+  qos.name(name_);
+  if (!config.interfaces.empty()) {
+    bool any_udp = false;
+    for (auto& t : qos.transport().user_transports) {
+      if (auto udp = std::dynamic_pointer_cast<eprosima::fastdds::rtps::UDPv4TransportDescriptor>(t)) {
+        udp->interfaceWhiteList = config.interfaces;
+        any_udp = true;
+      }
+    }
+    if (!any_udp) {
+      throw std::runtime_error("DDS profile '" + profile + "' has no UDPv4 transport to restrict to the given interfaces");
+    }
+  }
+  participant_ = factory->create_participant(static_cast<dds::DomainId_t>(config.domain), qos, listener,
+                                             dds::StatusMask::none());
+  if (participant_ == nullptr) {
+    throw std::runtime_error("component '" + name_ + "': could not create a DDS participant on domain " +
+                             std::to_string(config.domain) + " with profile '" + profile + "' (" + file + ")");
+  }
+}
+
+Context::~Context() {
+  executor_.stop();
+  if (participant_ != nullptr) {
+    participant_->delete_contained_entities();
+    dds::DomainParticipantFactory::get_instance()->delete_participant(participant_);
+  }
+}
+
+std::int64_t Context::now_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+dds::Publisher& Context::publisher() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (publisher_ == nullptr) {
+    publisher_ = participant_->create_publisher(dds::PUBLISHER_QOS_DEFAULT);
+    if (publisher_ == nullptr) throw std::runtime_error("component '" + name_ + "': could not create a DDS publisher");
+  }
+  return *publisher_;
+}
+
+dds::Subscriber& Context::subscriber() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (subscriber_ == nullptr) {
+    subscriber_ = participant_->create_subscriber(dds::SUBSCRIBER_QOS_DEFAULT);
+    if (subscriber_ == nullptr) throw std::runtime_error("component '" + name_ + "': could not create a DDS subscriber");
+  }
+  return *subscriber_;
+}
+
+dds::Topic& Context::topic(const std::string& name, dds::TopicDataType* support) {
+  dds::TypeSupport type(support);  // owns `support` from here on
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto it = topics_.find(name);
+  if (it != topics_.end()) {
+    if (it->second->get_type_name() != type.get_type_name()) {
+      throw std::runtime_error("component '" + name_ + "': topic " + name + " is already used with type " +
+                               it->second->get_type_name() + ", not " + type.get_type_name());
+    }
+    return *it->second;
+  }
+  apply_type_policy(*support);
+  const auto registered = participant_->find_type(type.get_type_name());
+  if (registered.empty()) {
+    if (participant_->register_type(type) != ReturnCode_t::RETCODE_OK) {
+      throw std::runtime_error("component '" + name_ + "': could not register type " + type.get_type_name());
+    }
+  }
+  auto* t = participant_->create_topic(name, type.get_type_name(), dds::TOPIC_QOS_DEFAULT);
+  if (t == nullptr) throw std::runtime_error("component '" + name_ + "': could not create topic " + name);
+  topics_[name] = t;
+  return *t;
+}
+
+std::shared_ptr<EndpointCounter> Context::add_counter(const std::string& topic, bool is_output) {
+  auto c = std::make_shared<EndpointCounter>();
+  c->topic = topic;
+  c->is_output = is_output;
+  std::lock_guard<std::mutex> lock(mutex_);
+  counters_.push_back(c);
+  return c;
+}
+
+void Context::track_reliable_writer(dds::DataWriter* w) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  reliable_writers_.push_back(w);
+}
+
+void Context::untrack_reliable_writer(dds::DataWriter* w) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  reliable_writers_.erase(std::remove(reliable_writers_.begin(), reliable_writers_.end(), w), reliable_writers_.end());
+}
+
+bool Context::flush(std::chrono::milliseconds timeout) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  bool all = true;
+  for (auto* w : reliable_writers_) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    const auto ms = std::max<std::int64_t>(0, left.count());
+    const eprosima::fastrtps::Duration_t d(static_cast<std::int32_t>(ms / 1000),
+                                           static_cast<std::uint32_t>((ms % 1000) * 1000000));
+    all = w->wait_for_acknowledgments(d) == ReturnCode_t::RETCODE_OK && all;
+  }
+  return all;
+}
+
+std::vector<std::shared_ptr<EndpointCounter>> Context::counters() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return counters_;
+}
+
+void Context::set_health(HealthState state, std::string message) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  health_ = state;
+  health_message_ = std::move(message);
+}
+
+std::pair<HealthState, std::string> Context::health() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return {health_, health_message_};
+}
+
+}  // namespace skelgraph::runtime

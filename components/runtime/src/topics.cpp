@@ -1,0 +1,28 @@
+#include "skelgraph/runtime/topics.hpp"
+
+namespace skelgraph::runtime {
+
+namespace {
+template <class T>
+TopicInfo info(const TopicDef<T>& def) {
+  return TopicInfo{def.name, msg::MessageTraits<T>::name, def.qos};
+}
+}  // namespace
+
+const std::vector<TopicInfo>& known_topics() {
+  static const std::vector<TopicInfo> table = {
+      info(topics::kSync),         info(topics::kSyncSession),   info(topics::kSyncControl),
+      info(topics::kSyncAck),      info(topics::kSkeletonRaw),   info(topics::kSkeletonFused),
+      info(topics::kSkeletonTruth), info(topics::kDepth),        info(topics::kCalibration),
+      info(topics::kGestureEvent), info(topics::kStatus)};
+  return table;
+}
+
+const TopicInfo* find_topic(const std::string& name) {
+  for (const auto& t : known_topics()) {
+    if (t.name == name) return &t;
+  }
+  return nullptr;
+}
+
+}  // namespace skelgraph::runtime

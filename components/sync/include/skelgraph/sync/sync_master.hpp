@@ -1,0 +1,38 @@
+#pragma once
+// `sync_master` component: publishes START / TICK / STOP on skelgraph/sync and
+// the session state on skelgraph/sync/session; obeys skelgraph/sync/control.
+
+#include <memory>
+#include <string>
+
+#include "skelgraph/runtime/component.hpp"
+#include "skelgraph/runtime/pubsub.hpp"
+#include "skelgraph/sync/sync_master_core.hpp"
+
+namespace skelgraph::sync {
+
+class SyncMaster final : public runtime::Component {
+ public:
+  SyncMaster(runtime::Context& ctx, const runtime::Params& params);
+  static runtime::ComponentInfo describe();
+
+  void on_start() override;
+  void on_shutdown() override;
+  std::string summary() const override;
+
+ private:
+  void start_session(const std::string& label, const std::string& request_id);
+  void publish(const std::vector<SyncEvent>& events);
+  void on_control(const msg::SyncControl& c);
+  static std::int64_t mono_ns();
+
+  SyncMasterCore core_;
+  bool autostart_;
+  std::string label_;
+  runtime::Publisher<msg::SyncCommand> sync_pub_;
+  runtime::Publisher<msg::SyncCommand> session_pub_;
+  runtime::Subscription<msg::SyncControl> control_sub_;
+  runtime::TimerHandle timer_;
+};
+
+}  // namespace skelgraph::sync

@@ -1,0 +1,108 @@
+#include "skelgraph/msg/json.hpp"
+
+namespace skelgraph::msg {
+
+namespace {
+const char* const kJointNames[JOINT_COUNT] = {
+    "head",      "neck",      "torso",     "left_shoulder", "left_elbow",
+    "left_hand", "right_shoulder", "right_elbow", "right_hand", "left_hip",
+    "left_knee", "left_foot", "right_hip", "right_knee",    "right_foot"};
+}  // namespace
+
+const char* joint_name(JointId id) {
+  const auto i = static_cast<std::uint32_t>(id);
+  return i < JOINT_COUNT ? kJointNames[i] : "unknown";
+}
+
+const char* to_string(SyncKind k) {
+  switch (k) {
+    case SYNC_START: return "START";
+    case SYNC_STOP: return "STOP";
+    case SYNC_TICK: return "TICK";
+  }
+  return "UNKNOWN";
+}
+
+const char* to_string(ComponentState s) {
+  switch (s) {
+    case STATE_OK: return "OK";
+    case STATE_DEGRADED: return "DEGRADED";
+    case STATE_ERROR: return "ERROR";
+  }
+  return "UNKNOWN";
+}
+
+void to_json(nlohmann::json& j, const Vec3& v) { j = {{"x", v.x()}, {"y", v.y()}, {"z", v.z()}}; }
+void to_json(nlohmann::json& j, const Quat& q) {
+  j = {{"w", q.w()}, {"x", q.x()}, {"y", q.y()}, {"z", q.z()}};
+}
+void to_json(nlohmann::json& j, const Joint& v) {
+  j = {{"position", v.position()},
+       {"orientation", v.orientation()},
+       {"confidence", v.confidence()},
+       {"sensor_mask", v.sensor_mask()}};
+}
+void to_json(nlohmann::json& j, const Skeleton& v) {
+  nlohmann::json joints = nlohmann::json::array();
+  for (std::uint32_t i = 0; i < JOINT_COUNT; ++i) {
+    nlohmann::json jj = v.joints()[i];
+    jj["name"] = kJointNames[i];
+    joints.push_back(std::move(jj));
+  }
+  j = {{"sensor_id", v.sensor_id()},     {"person_id", v.person_id()},
+       {"frame_id", v.frame_id()},       {"stamp_ns", v.stamp_ns()},
+       {"frame_number", v.frame_number()}, {"joints", std::move(joints)}};
+}
+void to_json(nlohmann::json& j, const SyncCommand& v) {
+  j = {{"kind", to_string(v.kind())}, {"session_id", v.session_id()}, {"label", v.label()},
+       {"tick", v.tick()},            {"master_stamp_ns", v.master_stamp_ns()},
+       {"request_id", v.request_id()}};
+}
+void to_json(nlohmann::json& j, const SyncControl& v) {
+  j = {{"kind", to_string(v.kind())}, {"label", v.label()}, {"requester", v.requester()},
+       {"request_id", v.request_id()}};
+}
+void to_json(nlohmann::json& j, const SyncAck& v) {
+  j = {{"component_name", v.component_name()}, {"host", v.host()},
+       {"session_id", v.session_id()},         {"tick", v.tick()},
+       {"master_stamp_ns", v.master_stamp_ns()}, {"receive_stamp_ns", v.receive_stamp_ns()},
+       {"send_stamp_ns", v.send_stamp_ns()}};
+}
+void to_json(nlohmann::json& j, const SensorPose& v) {
+  j = {{"sensor_id", v.sensor_id()},       {"frame_id", v.frame_id()},
+       {"translation", v.translation()},   {"rotation", v.rotation()},
+       {"stamp_ns", v.stamp_ns()},         {"method", v.method()},
+       {"rms_residual_m", v.rms_residual_m()}, {"max_residual_m", v.max_residual_m()}};
+}
+void to_json(nlohmann::json& j, const CameraIntrinsics& v) {
+  j = {{"fx", v.fx()}, {"fy", v.fy()}, {"cx", v.cx()}, {"cy", v.cy()}};
+}
+void to_json(nlohmann::json& j, const DepthFrame& v) {
+  // The image itself is summarised: a JSON array of 300k numbers helps nobody.
+  std::uint64_t valid = 0;
+  for (auto d : v.depth_mm()) valid += d != 0 ? 1 : 0;
+  j = {{"sensor_id", v.sensor_id()}, {"stamp_ns", v.stamp_ns()},
+       {"frame_number", v.frame_number()}, {"width", v.width()},
+       {"height", v.height()},       {"intrinsics", v.intrinsics()},
+       {"depth_mm_count", v.depth_mm().size()}, {"depth_mm_valid", valid}};
+}
+void to_json(nlohmann::json& j, const GestureEvent& v) {
+  j = {{"label", v.label()},           {"person_id", v.person_id()},
+       {"source", v.source()},         {"start_stamp_ns", v.start_stamp_ns()},
+       {"end_stamp_ns", v.end_stamp_ns()}, {"score", v.score()},
+       {"has_target", v.has_target()}, {"ray_origin", v.ray_origin()},
+       {"ray_direction", v.ray_direction()}, {"target", v.target()},
+       {"target_name", v.target_name()}};
+}
+void to_json(nlohmann::json& j, const TopicStats& v) {
+  j = {{"topic", v.topic()}, {"is_output", v.is_output()}, {"count", v.count()},
+       {"rate_hz", v.rate_hz()}, {"dropped", v.dropped()}};
+}
+void to_json(nlohmann::json& j, const ComponentStatus& v) {
+  j = {{"component_name", v.component_name()}, {"kind", v.kind()},
+       {"host", v.host()},                     {"stamp_ns", v.stamp_ns()},
+       {"state", to_string(v.state())},        {"message", v.message()},
+       {"topics", v.topics()}};
+}
+
+}  // namespace skelgraph::msg

@@ -1,0 +1,58 @@
+#include "skelgraph/msg/message_table.hpp"
+
+#include <memory>
+#include <stdexcept>
+
+#include "skelgraph/msg/json.hpp"
+#include "skelgraph/msg/messages.hpp"
+
+namespace skelgraph::msg {
+
+namespace {
+
+template <class T>
+MessageInfo make_info() {
+  using Support = typename MessageTraits<T>::PubSubType;
+  MessageInfo info;
+  info.type_name = MessageTraits<T>::name;
+  info.keyed = T::isKeyDefined();
+  info.make_type_support = [] { return new Support(); };
+  info.decode = [](const std::vector<std::uint8_t>& bytes) {
+    Support support;
+    eprosima::fastrtps::rtps::SerializedPayload_t payload(static_cast<std::uint32_t>(bytes.size()));
+    std::copy(bytes.begin(), bytes.end(), payload.data);
+    payload.length = static_cast<std::uint32_t>(bytes.size());
+    T value;
+    bool ok = false;
+    try {
+      ok = support.deserialize(&payload, &value);
+    } catch (const std::exception&) {
+      ok = false;
+    }
+    if (!ok) {
+      throw std::runtime_error("cannot decode " + std::to_string(bytes.size()) + " bytes as " +
+                               MessageTraits<T>::name);
+    }
+    return nlohmann::json(value);
+  };
+  return info;
+}
+
+}  // namespace
+
+const std::vector<MessageInfo>& message_table() {
+  static const std::vector<MessageInfo> table = {
+      make_info<Skeleton>(),   make_info<SyncCommand>(),  make_info<SyncControl>(),
+      make_info<SyncAck>(),    make_info<SensorPose>(),   make_info<DepthFrame>(),
+      make_info<GestureEvent>(), make_info<ComponentStatus>()};
+  return table;
+}
+
+const MessageInfo* find_message(const std::string& type_name) {
+  for (const auto& m : message_table()) {
+    if (m.type_name == type_name) return &m;
+  }
+  return nullptr;
+}
+
+}  // namespace skelgraph::msg

@@ -1,0 +1,49 @@
+#pragma once
+// Shared pieces of the `skelgraph` command-line program.
+
+#include <chrono>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "skelgraph/runtime/dds_config.hpp"
+#include "skelgraph/runtime/launch_file.hpp"
+
+namespace skelgraph::cli {
+
+// Bad input from the user (exit code 2); other exceptions exit with 1.
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct GlobalOptions {
+  std::optional<int> domain;
+  std::optional<std::string> profile;
+  std::vector<std::string> interfaces;
+  std::string log_level = "info";
+};
+
+// DDS settings: command line, then environment, then launch file, then defaults.
+runtime::DdsConfig make_config(const GlobalOptions& g, const runtime::LaunchSpec* spec = nullptr);
+
+// Adds --domain/--profile/--interface to a subcommand that talks DDS.
+void add_dds_options(CLI::App& cmd, GlobalOptions& g);
+
+// SIGINT/SIGTERM are blocked in every thread from the start; these wait for them.
+void block_signals();
+// True if a signal arrived within `timeout`.
+bool wait_for_signal(std::chrono::milliseconds timeout);
+
+// Each returns the subcommand it added; `run` is set to its action.
+using Action = std::function<int()>;
+void add_launch_command(CLI::App& app, GlobalOptions& g, Action& run);
+void add_topic_command(CLI::App& app, GlobalOptions& g, Action& run);
+void add_sync_command(CLI::App& app, GlobalOptions& g, Action& run);
+void add_demo_command(CLI::App& app, GlobalOptions& g, Action& run);
+void add_components_command(CLI::App& app, GlobalOptions& g, Action& run);
+
+}  // namespace skelgraph::cli

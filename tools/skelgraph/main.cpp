@@ -1,0 +1,112 @@
+// skelgraph: the command-line front end (launch, topic, sync, demo, components).
+
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+
+#include <fastdds/dds/log/Log.hpp>
+#include <fastdds/dds/log/StdoutErrConsumer.hpp>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include "cli.hpp"
+
+namespace skelgraph::cli {
+
+runtime::DdsConfig make_config(const GlobalOptions& g, const runtime::LaunchSpec* spec) {
+  auto c = runtime::DdsConfig::from_env();
+  const bool env_domain = std::getenv("SKELGRAPH_DOMAIN") != nullptr;
+  const bool env_profile = std::getenv("SKELGRAPH_PROFILE") != nullptr;
+  if (spec != nullptr) {
+    if (spec->domain && !env_domain) c.domain = *spec->domain;
+    if (spec->profile && !env_profile) c.profile = *spec->profile;
+  }
+  if (g.domain) c.domain = *g.domain;
+  if (g.profile) c.profile = *g.profile;
+  if (!g.interfaces.empty()) c.interfaces = g.interfaces;
+  return c;
+}
+
+void add_dds_options(CLI::App& cmd, GlobalOptions& g) {
+  cmd.add_option("--domain", g.domain, "DDS domain id (default: $SKELGRAPH_DOMAIN, else 0)")->check(CLI::Range(0, 232));
+  cmd.add_option("--profile", g.profile,
+                 "DDS profile: loopback (default), lan, or a path to an XML file (env SKELGRAPH_PROFILE)");
+  cmd.add_option("--interface", g.interfaces, "restrict UDP to this interface address (repeatable; lan profile)");
+}
+
+void block_signals() {
+  sigset_t set;
+  sigemptyset(&set);
+  sigaddset(&set, SIGINT);
+  sigaddset(&set, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &set, nullptr);
+}
+
+bool wait_for_signal(std::chrono::milliseconds timeout) {
+  sigset_t set;
+  sigemptyset(&set);
+  sigaddset(&set, SIGINT);
+  sigaddset(&set, SIGTERM);
+  const auto ms = timeout.count() < 0 ? 0 : timeout.count();
+  timespec ts{static_cast<time_t>(ms / 1000), static_cast<long>((ms % 1000) * 1000000)};
+  return sigtimedwait(&set, nullptr, &ts) > 0;
+}
+
+namespace {
+void setup_logging(const std::string& level) {
+  // Logs go to stderr so stdout stays clean for --json output.
+  auto logger = spdlog::stderr_color_mt("skelgraph");
+  spdlog::set_default_logger(logger);
+  spdlog::set_pattern("[%H:%M:%S.%e] [%^%l%$] %v");
+  spdlog::set_level(spdlog::level::from_str(level));
+  // Fast DDS logs to stdout by default; send its warnings and errors to stderr.
+  namespace dl = eprosima::fastdds::dds;
+  dl::Log::ClearConsumers();
+  dl::Log::RegisterConsumer(std::make_unique<dl::StdoutErrConsumer>());
+  dl::Log::SetVerbosity(level == "trace"   ? dl::Log::Kind::Info
+                        : level == "debug" ? dl::Log::Kind::Warning
+                                           : dl::Log::Kind::Error);
+}
+}  // namespace
+
+}  // namespace skelgraph::cli
+
+int main(int argc, char** argv) {
+  using namespace skelgraph::cli;
+  block_signals();
+  CLI::App app{"skelgraph: multi-sensor skeleton fusion on DDS. Run a subcommand with --help for its options."};
+  app.require_subcommand(1);
+  GlobalOptions g;
+  app.add_option("--log-level", g.log_level, "trace, debug, info, warn, error, off")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
+  Action run;
+  add_launch_command(app, g, run);
+  add_topic_command(app, g, run);
+  add_sync_command(app, g, run);
+  add_demo_command(app, g, run);
+  add_components_command(app, g, run);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : 2;
+  }
+  setup_logging(g.log_level);
+  int rc = 1;
+  try {
+    rc = run ? run() : 2;
+  } catch (const UsageError& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    rc = 2;
+  } catch (const skelgraph::runtime::LaunchError& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    rc = 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    rc = 1;
+  }
+  spdlog::shutdown();
+  eprosima::fastdds::dds::Log::Flush();
+  return rc;
+}

@@ -1,0 +1,70 @@
+#include "run_graph.hpp"
+
+#include <chrono>
+#include <cstdio>
+
+#include <spdlog/spdlog.h>
+
+#include "cli.hpp"
+
+namespace skelgraph::cli {
+
+namespace {
+void print_reports(const runtime::Graph& graph, const char* when) {
+  for (const auto& r : graph.report()) {
+    std::fprintf(stderr, "[%s] %s (%s) %s%s%s%s%s\n", when, r.name.c_str(), r.kind.c_str(), r.state.c_str(),
+                 r.message.empty() ? "" : (" - " + r.message).c_str(), r.summary.empty() ? "" : ": ",
+                 r.summary.c_str(), r.io.empty() ? "" : (" | " + r.io).c_str());
+  }
+}
+}  // namespace
+
+int run_graph(const runtime::ComponentRegistry& registry, const runtime::DdsConfig& config,
+              const std::vector<runtime::ResolvedComponent>& components, const RunOptions& options,
+              const std::function<void(runtime::Graph&, nlohmann::json&)>& extra_report) {
+  runtime::Graph graph(registry, config);
+  graph.add_all(components);
+  graph.start();
+  for (const auto& c : components) {
+    std::fprintf(stderr, "[start] %s (%s) on domain %d, profile %s, host %s\n", c.name.c_str(), c.kind.c_str(),
+                 config.domain, config.profile.c_str(), config.host.c_str());
+  }
+  using clock = std::chrono::steady_clock;
+  const auto t0 = clock::now();
+  const auto end = options.duration_s > 0
+                       ? t0 + std::chrono::duration_cast<clock::duration>(std::chrono::duration<double>(options.duration_s))
+                       : clock::time_point::max();
+  auto next_status = options.status_every_s > 0
+                         ? t0 + std::chrono::duration_cast<clock::duration>(
+                                    std::chrono::duration<double>(options.status_every_s))
+                         : clock::time_point::max();
+  bool signalled = false;
+  while (!signalled) {
+    const auto now = clock::now();
+    if (now >= end) break;
+    const auto until = std::min({end, next_status, now + std::chrono::seconds(1)});
+    signalled = wait_for_signal(std::chrono::duration_cast<std::chrono::milliseconds>(until - now) +
+                                std::chrono::milliseconds(1));
+    if (clock::now() >= next_status) {
+      print_reports(graph, "status");
+      next_status += std::chrono::duration_cast<clock::duration>(std::chrono::duration<double>(options.status_every_s));
+    }
+  }
+  if (signalled) spdlog::info("signal received, stopping");
+  graph.stop();
+  print_reports(graph, "stop");
+  nlohmann::json report;
+  report["components"] = nlohmann::json::array();
+  for (const auto& r : graph.report()) {
+    report["components"].push_back(
+        {{"name", r.name}, {"kind", r.kind}, {"state", r.state}, {"message", r.message}, {"summary", r.summary}, {"io", r.io}});
+  }
+  report["duration_s"] = std::chrono::duration<double>(clock::now() - t0).count();
+  report["domain"] = config.domain;
+  report["profile"] = config.profile;
+  if (extra_report) extra_report(graph, report);
+  if (options.json) std::printf("%s\n", report.dump(2).c_str());
+  return 0;
+}
+
+}  // namespace skelgraph::cli

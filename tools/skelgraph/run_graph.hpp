@@ -1,0 +1,27 @@
+#pragma once
+// Runs a resolved graph in this process until a signal or the duration ends,
+// printing a status line per component at start, on request and at the end.
+
+#include <functional>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "skelgraph/runtime/dds_config.hpp"
+#include "skelgraph/runtime/graph.hpp"
+#include "skelgraph/runtime/launch_file.hpp"
+
+namespace skelgraph::cli {
+
+struct RunOptions {
+  double duration_s = 0.0;      // 0: until a signal
+  double status_every_s = 0.0;  // 0: only at start and end
+  bool json = false;            // final report as JSON on stdout
+};
+
+// `extra_report` (optional) adds to the final JSON / text after the graph stopped.
+int run_graph(const runtime::ComponentRegistry& registry, const runtime::DdsConfig& config,
+              const std::vector<runtime::ResolvedComponent>& components, const RunOptions& options,
+              const std::function<void(runtime::Graph&, nlohmann::json&)>& extra_report);
+
+}  // namespace skelgraph::cli
