@@ -76,7 +76,6 @@ int main(int argc, char** argv) {
   using namespace skelgraph::cli;
   block_signals();
   CLI::App app{"skelgraph: multi-sensor skeleton fusion on DDS. Run a subcommand with --help for its options."};
-  app.require_subcommand(1);
   GlobalOptions g;
   app.add_option("--log-level", g.log_level, "trace, debug, info, warn, error, off")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
@@ -91,6 +90,10 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     const int rc = app.exit(e);
     return rc == 0 ? 0 : 2;
+  }
+  if (!run) {
+    std::fprintf(stderr, "%s\nerror: a subcommand is required\n", app.help().c_str());
+    return 2;
   }
   setup_logging(g.log_level);
   int rc = 1;

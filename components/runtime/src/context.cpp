@@ -50,6 +50,7 @@ Context::Context(std::string name, const DdsConfig& config, dds::DomainParticipa
     throw std::runtime_error("DDS profile file " + file + " has no participant profile named '" + profile + "'");
   }
   qos.name(name_);
+  apply_type_policy(qos);
   if (!config.interfaces.empty()) {
     bool any_udp = false;
     for (auto& t : qos.transport().user_transports) {
@@ -124,6 +125,24 @@ dds::Topic& Context::topic(const std::string& name, dds::TopicDataType* support)
   if (t == nullptr) throw std::runtime_error("component '" + name_ + "': could not create topic " + name);
   topics_[name] = t;
   return *t;
+}
+
+void EndpointCounter::set_matched(int n) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    matched_ = n < 0 ? 0 : static_cast<std::size_t>(n);
+  }
+  cv_.notify_all();
+}
+
+std::size_t EndpointCounter::matched() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return matched_;
+}
+
+bool EndpointCounter::wait_matched(std::size_t n, std::chrono::milliseconds timeout) const {
+  std::unique_lock<std::mutex> lock(mutex_);
+  return cv_.wait_for(lock, timeout, [&] { return matched_ >= n; });
 }
 
 std::shared_ptr<EndpointCounter> Context::add_counter(const std::string& topic, bool is_output) {

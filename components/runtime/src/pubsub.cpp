@@ -42,49 +42,28 @@ std::int64_t to_ns(const eprosima::fastrtps::rtps::Time_t& t) {
   return static_cast<std::int64_t>(t.seconds()) * 1000000000LL + static_cast<std::int64_t>(t.nanosec());
 }
 
-// Matched-count bookkeeping shared by writer and reader listeners.
-struct MatchCount {
-  mutable std::mutex mutex;
-  mutable std::condition_variable cv;
-  std::size_t current = 0;
-  void set(int count) {
-    {
-      std::lock_guard<std::mutex> lock(mutex);
-      current = count < 0 ? 0 : static_cast<std::size_t>(count);
-    }
-    cv.notify_all();
-  }
-  std::size_t get() const {
-    std::lock_guard<std::mutex> lock(mutex);
-    return current;
-  }
-  bool wait(std::size_t n, std::chrono::milliseconds timeout) const {
-    std::unique_lock<std::mutex> lock(mutex);
-    return cv.wait_for(lock, timeout, [&] { return current >= n; });
-  }
-};
-
 }  // namespace
 
 // ---- writer ----
 
 struct WriterBase::Listener final : dds::DataWriterListener {
-  MatchCount matched;
+  std::shared_ptr<EndpointCounter> counter;
   void on_publication_matched(dds::DataWriter*, const dds::PublicationMatchedStatus& s) override {
-    matched.set(s.current_count);
+    counter->set_matched(s.current_count);
   }
 };
 
 WriterBase::WriterBase(Context& ctx, const std::string& topic, dds::TopicDataType* support, const QosPreset& qos)
     : ctx_(ctx), qos_(qos), listener_(std::make_unique<Listener>()) {
   auto& t = ctx.topic(topic, support);
+  counter_ = ctx.add_counter(topic, true);
+  listener_->counter = counter_;
   dds::DataWriterQos wq = dds::DATAWRITER_QOS_DEFAULT;
   apply(qos, wq);
   writer_ = ctx.publisher().create_datawriter(&t, wq, listener_.get(), dds::StatusMask::publication_matched());
   if (writer_ == nullptr) {
     throw std::runtime_error("component '" + ctx.name() + "': could not create a writer on " + topic);
   }
-  counter_ = ctx.add_counter(topic, true);
   if (qos.reliability == Reliability::Reliable) ctx.track_reliable_writer(writer_);
 }
 
@@ -109,10 +88,10 @@ bool WriterBase::write(void* sample) {
   return ok;
 }
 
-std::size_t WriterBase::matched() const { return listener_->matched.get(); }
+std::size_t WriterBase::matched() const { return counter_->matched(); }
 
 bool WriterBase::wait_for_matched(std::size_t n, std::chrono::milliseconds timeout) const {
-  return listener_->matched.wait(n, timeout);
+  return counter_->wait_matched(n, timeout);
 }
 
 bool WriterBase::wait_for_acks(std::chrono::milliseconds timeout) {
@@ -135,7 +114,6 @@ struct ReaderBase::State final : dds::DataReaderListener, std::enable_shared_fro
   Deliver deliver;
   std::shared_ptr<EndpointCounter> counter;
   std::atomic<bool> pending{false};
-  MatchCount matched;
 
   ~State() override {
     if (sample != nullptr) type.delete_data(sample);
@@ -149,7 +127,7 @@ struct ReaderBase::State final : dds::DataReaderListener, std::enable_shared_fro
     });
   }
   void on_subscription_matched(dds::DataReader*, const dds::SubscriptionMatchedStatus& s) override {
-    matched.set(s.current_count);
+    counter->set_matched(s.current_count);
   }
   void on_sample_lost(dds::DataReader*, const dds::SampleLostStatus& s) override {
     counter->dropped.fetch_add(static_cast<std::uint64_t>(s.total_count_change), std::memory_order_relaxed);
@@ -201,10 +179,10 @@ ReaderBase::~ReaderBase() {
   state_->reader = nullptr;
 }
 
-std::size_t ReaderBase::matched() const { return state_->matched.get(); }
+std::size_t ReaderBase::matched() const { return state_->counter->matched(); }
 
 bool ReaderBase::wait_for_matched(std::size_t n, std::chrono::milliseconds timeout) const {
-  return state_->matched.wait(n, timeout);
+  return state_->counter->wait_matched(n, timeout);
 }
 
 }  // namespace skelgraph::runtime

@@ -2,6 +2,7 @@
 
 #include <mutex>
 
+#include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 #include <fastdds/dds/topic/TopicDataType.hpp>
 #include <skelgraphTypeObject.h>
 
@@ -14,9 +15,17 @@ void register_type_objects() {
 
 void apply_type_policy(eprosima::fastdds::dds::TopicDataType& support) {
   // Announce the TypeInformation (type identifiers) but not the full
-  // TypeObject: see docs/type-information.md for the measured trade-off.
+  // TypeObject: a Fast DDS 2.9 peer that receives the TypeObject of a type
+  // with an array or sequence of structs/enums (Skeleton, ComponentStatus)
+  // and has not registered it itself crashes (eProsima/Fast-DDS#3296).
+  // See docs/type-information.md for the measured trade-off.
   support.auto_fill_type_information(true);
   support.auto_fill_type_object(false);
+}
+
+void apply_type_policy(eprosima::fastdds::dds::DomainParticipantQos& qos) {
+  // Off by default in Fast DDS 2.9 and not settable from XML.
+  qos.wire_protocol().builtin.typelookup_config.use_server = true;
 }
 
 }  // namespace skelgraph::runtime

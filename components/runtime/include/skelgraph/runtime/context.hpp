@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -33,6 +34,16 @@ struct EndpointCounter {
   bool is_output = false;
   std::atomic<std::uint64_t> count{0};
   std::atomic<std::uint64_t> dropped{0};
+
+  // Remote endpoints currently matched (set from DDS listener threads).
+  void set_matched(int n);
+  std::size_t matched() const;
+  bool wait_matched(std::size_t n, std::chrono::milliseconds timeout) const;
+
+ private:
+  mutable std::mutex mutex_;
+  mutable std::condition_variable cv_;
+  std::size_t matched_ = 0;
 };
 
 enum class HealthState { Ok, Degraded, Error };

@@ -4,6 +4,7 @@
 // Fast DDS 2.9 peer survives discovering them (see docs/type-information.md).
 
 namespace eprosima::fastdds::dds {
+class DomainParticipantQos;
 class TopicDataType;
 }
 
@@ -13,5 +14,7 @@ namespace skelgraph::runtime {
 void register_type_objects();
 // Sets what `support` announces; called for every type a Context registers.
 void apply_type_policy(eprosima::fastdds::dds::TopicDataType& support);
+// Participant side: answers TypeLookup requests so tools can fetch our types.
+void apply_type_policy(eprosima::fastdds::dds::DomainParticipantQos& qos);
 
 }  // namespace skelgraph::runtime

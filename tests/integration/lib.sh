@@ -1,0 +1,27 @@
+# Shared helpers for the integration scripts (sourced). They run inside
+# tests/netns-lo.sh, so every process here sees only the loopback interface.
+set -euo pipefail
+SKELGRAPH=${1:?usage: $0 path/to/skelgraph}
+SRC=${SKELGRAPH_SOURCE_DIR:?set by ctest}
+WORK=$(mktemp -d)
+trap 'kill $(jobs -p) 2>/dev/null || true; rm -rf "$WORK"' EXIT
+cd "$SRC"
+
+fail() { echo "FAIL: $*" >&2; exit 1; }
+ok() { echo "ok: $*"; }
+
+# json_check FILE PYTHON_EXPR: the expression (over `d`, the parsed JSON) must be true.
+json_check() {
+  python3 - "$1" "$2" <<'PY' || fail "check failed: $2 on $(cat "$1")"
+import json, sys
+d = json.load(open(sys.argv[1]))
+sys.exit(0 if eval(sys.argv[2]) else 1)
+PY
+}
+
+# retry N CMD...: runs CMD until it succeeds, at most N times (each try is itself bounded).
+retry() {
+  local n=$1; shift
+  for _ in $(seq "$n"); do "$@" && return 0; done
+  return 1
+}
