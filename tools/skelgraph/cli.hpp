@@ -30,6 +30,10 @@ struct GlobalOptions {
 // DDS settings: command line, then environment, then launch file, then defaults.
 runtime::DdsConfig make_config(const GlobalOptions& g, const runtime::LaunchSpec* spec = nullptr);
 
+// Option checks with messages a user can read ("must be >= 0, got -3").
+extern const CLI::Validator kNonNegative;
+extern const CLI::Validator kPositive;
+
 // Adds --domain/--profile/--interface to a subcommand that talks DDS.
 void add_dds_options(CLI::App& cmd, GlobalOptions& g);
 

@@ -33,7 +33,7 @@ void add_demo_command(CLI::App& app, GlobalOptions& g, Action& run) {
   };
   auto o = std::make_shared<Opts>();
   auto* cmd = app.add_subcommand("demo", "Run the demo graph (sync master + monitor) and print what it saw");
-  cmd->add_option("--duration", o->duration, "seconds to run")->check(CLI::PositiveNumber);
+  cmd->add_option("--duration", o->duration, "seconds to run")->check(kPositive);
   cmd->add_flag("--json", o->json, "print the report as JSON on stdout");
   add_dds_options(*cmd, g);
   cmd->callback([o, &g, &run] {

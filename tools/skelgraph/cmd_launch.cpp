@@ -24,9 +24,9 @@ void add_launch_command(CLI::App& app, GlobalOptions& g, Action& run) {
   cmd->add_option("file", o->file, "launch file (YAML), e.g. bringup/sync.yaml")->required();
   cmd->add_option("--host", o->host, "run only the components listed for this host");
   cmd->add_option("--duration", o->duration, "stop after this many seconds (default: until SIGINT/SIGTERM)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegative);
   cmd->add_option("--status-every", o->status_every, "print each component's status line every S seconds")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegative);
   cmd->add_flag("--json", o->json, "print the final report as JSON on stdout");
   add_dds_options(*cmd, g);
   cmd->callback([o, &g, &run] {

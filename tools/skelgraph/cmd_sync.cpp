@@ -85,7 +85,7 @@ void add_sync_command(CLI::App& app, GlobalOptions& g, Action& run) {
   start->add_option("--label", o->label, "session label (recordings are named after it)");
   auto* stop = sync->add_subcommand("stop", "Stop the running session");
   for (auto* c : {start, stop}) {
-    c->add_option("--timeout", o->timeout, "seconds to wait for the sync master")->check(CLI::PositiveNumber);
+    c->add_option("--timeout", o->timeout, "seconds to wait for the sync master")->check(kPositive);
     c->add_flag("--json", o->json, "print the confirming START/STOP as JSON");
     add_dds_options(*c, g);
   }

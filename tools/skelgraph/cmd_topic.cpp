@@ -231,7 +231,7 @@ void add_topic_command(CLI::App& app, GlobalOptions& g, Action& run) {
   auto o = std::make_shared<Opts>();
 
   auto* l = topic->add_subcommand("list", "Topics seen on the domain, with type names and writer/reader counts");
-  l->add_option("--wait", o->wait, "seconds to listen to discovery before printing")->check(CLI::PositiveNumber);
+  l->add_option("--wait", o->wait, "seconds to listen to discovery before printing")->check(kPositive);
   l->add_flag("--json", o->json, "print JSON");
   l->add_flag("--all", o->all, "include non-skelgraph topics");
   add_dds_options(*l, g);
@@ -241,7 +241,7 @@ void add_topic_command(CLI::App& app, GlobalOptions& g, Action& run) {
   e->add_option("topic", o->topic, "topic name, e.g. skelgraph/sync")->required();
   e->add_option("--count", o->count, "exit after N samples (default: until Ctrl-C)");
   e->add_option("--timeout", o->timeout, "fail if nothing arrives within S seconds (0: wait forever)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegative);
   e->add_flag("--json", o->json, "one JSON object per line");
   add_dds_options(*e, g);
   e->callback([o, &g, &run] {
@@ -250,10 +250,10 @@ void add_topic_command(CLI::App& app, GlobalOptions& g, Action& run) {
 
   auto* h = topic->add_subcommand("hz", "Measure a topic's publishing rate at this reader");
   h->add_option("topic", o->topic, "topic name")->required();
-  h->add_option("--window", o->window, "seconds of arrivals the statistics cover")->check(CLI::PositiveNumber);
-  h->add_option("--timeout", o->timeout, "fail if nothing arrives within S seconds")->check(CLI::PositiveNumber);
+  h->add_option("--window", o->window, "seconds of arrivals the statistics cover")->check(kPositive);
+  h->add_option("--timeout", o->timeout, "fail if nothing arrives within S seconds")->check(kPositive);
   h->add_option("--duration", o->duration, "stop after S seconds (interactive mode; default: until Ctrl-C)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(kNonNegative);
   h->add_flag("--json", o->json,
               "measure one window after the first sample, print {rate_hz, samples, min/max/std period} and exit");
   add_dds_options(*h, g);

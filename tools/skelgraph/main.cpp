@@ -28,6 +28,28 @@ runtime::DdsConfig make_config(const GlobalOptions& g, const runtime::LaunchSpec
   return c;
 }
 
+namespace {
+CLI::Validator number_check(bool allow_zero) {
+  return CLI::Validator(
+      [allow_zero](std::string& text) -> std::string {
+        double v = 0.0;
+        try {
+          std::size_t used = 0;
+          v = std::stod(text, &used);
+          if (used != text.size()) throw std::invalid_argument(text);
+        } catch (const std::exception&) {
+          return "expected a number, got '" + text + "'";
+        }
+        if (allow_zero ? v < 0.0 : v <= 0.0) return std::string("must be ") + (allow_zero ? ">= 0" : "> 0") + ", got " + text;
+        return {};
+      },
+      allow_zero ? "NUMBER>=0" : "NUMBER>0");
+}
+}  // namespace
+
+const CLI::Validator kNonNegative = number_check(true);
+const CLI::Validator kPositive = number_check(false);
+
 void add_dds_options(CLI::App& cmd, GlobalOptions& g) {
   cmd.add_option("--domain", g.domain, "DDS domain id (default: $SKELGRAPH_DOMAIN, else 0)")->check(CLI::Range(0, 232));
   cmd.add_option("--profile", g.profile,
