@@ -26,8 +26,11 @@ expect_error "no components for host 'nowhere'" launch bringup/sync.yaml --host 
 expect_error "duration" launch bringup/sync.yaml --duration -3
 expect_error "required" topic echo
 expect_error "nope" nope
+expect_error "unknown component type 'fusionx'" run fusionx
+expect_error "--param tick=3: component 'sync_master' (sync_master): unknown parameter 'tick'" run sync_master -p tick=3
+expect_error "expected KEY=VALUE" run sync_master -p tick
 
-for cmd in "" "launch" "topic" "topic list" "topic echo" "topic hz" "sync" "sync start" "sync stop" "demo" "components"; do
+for cmd in "" "launch" "run" "topic" "topic list" "topic echo" "topic hz" "sync" "sync start" "sync stop" "demo" "components"; do
   # shellcheck disable=SC2086
   "$SKELGRAPH" $cmd --help >"$WORK/help" || fail "skelgraph $cmd --help failed"
   grep -q "Usage" "$WORK/help" || fail "skelgraph $cmd --help printed no usage"

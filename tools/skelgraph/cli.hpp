@@ -42,9 +42,10 @@ void block_signals();
 // True if a signal arrived within `timeout`.
 bool wait_for_signal(std::chrono::milliseconds timeout);
 
-// Each returns the subcommand it added; `run` is set to its action.
+// Each adds a subcommand; when the user picks it, `run` is set to its action.
 using Action = std::function<int()>;
 void add_launch_command(CLI::App& app, GlobalOptions& g, Action& run);
+void add_run_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_topic_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_sync_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_demo_command(CLI::App& app, GlobalOptions& g, Action& run);

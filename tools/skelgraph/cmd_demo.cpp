@@ -4,7 +4,6 @@
 
 #include "cli.hpp"
 #include "run_graph.hpp"
-#include "skelgraph/monitor/monitor.hpp"
 #include "skelgraph/runtime/launch_file.hpp"
 #include "skelgraph/runtime/registry.hpp"
 
@@ -45,14 +44,17 @@ void add_demo_command(CLI::App& app, GlobalOptions& g, Action& run) {
       RunOptions ro;
       ro.duration_s = o->duration;
       ro.json = o->json;
-      std::printf("skelgraph demo: sync master + monitor on DDS domain %d (profile %s) for %.1f s\n",
+      if (!o->json) std::printf("skelgraph demo: sync master + monitor on DDS domain %d (profile %s) for %.1f s\n",
                   make_config(g, &spec).domain, make_config(g, &spec).profile.c_str(), o->duration);
       return run_graph(registry, make_config(g, &spec), components, ro,
                        [o](runtime::Graph& graph, nlohmann::json& report) {
-                         auto& monitor = dynamic_cast<monitor::Monitor&>(graph.component("monitor"));
-                         report["seen"] = monitor.observations();
+                         nlohmann::json seen;
+                         for (const auto& r : graph.report()) {
+                           if (r.name == "monitor") seen = r.details;
+                         }
+                         report["seen"] = seen;
                          if (o->json) return;
-                         for (const auto& s : report["seen"]["sessions"]) {
+                         for (const auto& s : seen["sessions"]) {
                            std::printf(
                                "session %u '%s': START %s, %llu ticks at %.2f Hz (period %.1f-%.1f ms, std %.2f ms), "
                                "%llu missing, STOP %s\n",
@@ -63,7 +65,7 @@ void add_demo_command(CLI::App& app, GlobalOptions& g, Action& run) {
                                s["tick_period_std_ms"].get<double>(), s["missing_ticks"].get<unsigned long long>(),
                                s["saw_stop"].get<bool>() ? "seen" : "not seen");
                          }
-                         for (const auto& [name, st] : report["seen"]["status"].items()) {
+                         for (const auto& [name, st] : seen["status"].items()) {
                            std::printf("component %s (%s): %s\n", name.c_str(),
                                        st["kind"].get<std::string>().c_str(), st["state"].get<std::string>().c_str());
                          }

@@ -103,6 +103,7 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
   Action run;
   add_launch_command(app, g, run);
+  add_run_command(app, g, run);
   add_topic_command(app, g, run);
   add_sync_command(app, g, run);
   add_demo_command(app, g, run);

@@ -57,7 +57,8 @@ int run_graph(const runtime::ComponentRegistry& registry, const runtime::DdsConf
   report["components"] = nlohmann::json::array();
   for (const auto& r : graph.report()) {
     report["components"].push_back(
-        {{"name", r.name}, {"kind", r.kind}, {"state", r.state}, {"message", r.message}, {"summary", r.summary}, {"io", r.io}});
+        {{"name", r.name}, {"kind", r.kind}, {"state", r.state}, {"message", r.message}, {"summary", r.summary}, {"io", r.io},
+         {"details", r.details}});
   }
   report["duration_s"] = std::chrono::duration<double>(clock::now() - t0).count();
   report["domain"] = config.domain;

@@ -32,7 +32,7 @@ void Monitor::on_command(const msg::SyncCommand& c, std::int64_t receive_ns) {
   watch_.on_command(kind, c.session_id(), c.label().to_string(), c.tick(), receive_ns);
 }
 
-nlohmann::json Monitor::observations() const {
+nlohmann::json Monitor::details() const {
   nlohmann::json sessions = nlohmann::json::array();
   for (const auto& s : watch_.sessions()) {
     sessions.push_back({{"session_id", s.session_id},

@@ -137,6 +137,7 @@ std::vector<NodeReport> Graph::report() const {
     r.state = to_text(state);
     r.message = message;
     r.summary = n->component->summary();
+    r.details = n->component->details();
     std::ostringstream io;
     for (const auto& c : n->context->counters()) {
       if (c->topic == topics::kStatus.name) continue;
@@ -152,13 +153,6 @@ std::vector<NodeReport> Graph::report() const {
 Context& Graph::context(const std::string& name) {
   for (auto& n : nodes_) {
     if (n->context->name() == name) return *n->context;
-  }
-  throw std::out_of_range("no component named '" + name + "'");
-}
-
-Component& Graph::component(const std::string& name) {
-  for (auto& n : nodes_) {
-    if (n->context->name() == name) return *n->component;
   }
   throw std::out_of_range("no component named '" + name + "'");
 }

@@ -96,6 +96,12 @@ void SyncMaster::publish(const std::vector<SyncEvent>& events) {
   }
 }
 
+nlohmann::json SyncMaster::details() const {
+  return {{"sessions_started", core_.sessions_started()}, {"session_id", core_.session_id()},
+          {"label", core_.label()},                       {"running", core_.running()},
+          {"ticks_sent", core_.ticks_sent()},             {"ticks_skipped", core_.ticks_skipped()}};
+}
+
 std::string SyncMaster::summary() const {
   std::ostringstream os;
   os << core_.sessions_started() << " session(s); last " << core_.session_id() << " '" << core_.label() << "' "

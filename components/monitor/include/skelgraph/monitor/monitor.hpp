@@ -18,8 +18,8 @@ class Monitor final : public runtime::Component {
   Monitor(runtime::Context& ctx, const runtime::Params& params);
   static runtime::ComponentInfo describe();
   std::string summary() const override;
-  // Everything seen so far; call after the graph stopped.
-  nlohmann::json observations() const;
+  // Sessions (START/STOP, ticks, gaps, rate) and the last status of each component.
+  nlohmann::json details() const override;
 
  private:
   void on_command(const msg::SyncCommand& c, std::int64_t receive_ns);

@@ -6,6 +6,8 @@
 
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "skelgraph/runtime/context.hpp"
 #include "skelgraph/runtime/params.hpp"
 #include "skelgraph/runtime/registry.hpp"
@@ -24,6 +26,8 @@ class Component {
   virtual void on_shutdown() {}
   // One line for the launcher's report ("42 ticks, session 7").
   virtual std::string summary() const { return {}; }
+  // The same, machine-readable, for `--json` reports (null when there is nothing).
+  virtual nlohmann::json details() const { return nullptr; }
 
  protected:
   Context& ctx_;

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "skelgraph/runtime/dds_config.hpp"
 #include "skelgraph/runtime/launch_file.hpp"
 #include "skelgraph/runtime/registry.hpp"
@@ -24,6 +26,7 @@ struct NodeReport {
   std::string message;
   std::string summary;  // the component's own line
   std::string io;       // "out skelgraph/sync 181, in ... " counts
+  nlohmann::json details;  // the component's own machine-readable report
 };
 
 class Graph {
@@ -42,9 +45,9 @@ class Graph {
   void start();  // starts every executor, then on_start() of each component
   void stop();   // on_shutdown() of each (reverse order), then stops executors; idempotent
 
+  // Call after stop(): components are not locked while they report.
   std::vector<NodeReport> report() const;
   Context& context(const std::string& name);
-  Component& component(const std::string& name);
 
  private:
   struct Node;

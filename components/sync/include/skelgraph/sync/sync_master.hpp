@@ -19,6 +19,7 @@ class SyncMaster final : public runtime::Component {
   void on_start() override;
   void on_shutdown() override;
   std::string summary() const override;
+  nlohmann::json details() const override;
 
  private:
   void start_session(const std::string& label, const std::string& request_id);
