@@ -11,17 +11,14 @@ void add_run_command(CLI::App& app, GlobalOptions& g, Action& run) {
     std::string kind;
     std::string name;
     std::vector<std::string> params;
-    double duration = 0.0;
-    bool json = false;
+    RunOptions run;
   };
   auto o = std::make_shared<Opts>();
   auto* cmd = app.add_subcommand("run", "Run one component in this process, parameters from the command line");
   cmd->add_option("type", o->kind, "component type (see `skelgraph components`)")->required();
   cmd->add_option("--name", o->name, "component name (default: the type)");
   cmd->add_option("-p,--param", o->params, "parameter as KEY=VALUE (repeatable; lists as a,b,c)");
-  cmd->add_option("--duration", o->duration, "stop after this many seconds (default: until SIGINT/SIGTERM)")
-      ->check(kNonNegative);
-  cmd->add_flag("--json", o->json, "print the final report as JSON on stdout");
+  add_run_options(*cmd, o->run);
   add_dds_options(*cmd, g);
   cmd->callback([o, &g, &run] {
     run = [o, &g] {
@@ -33,21 +30,18 @@ void add_run_command(CLI::App& app, GlobalOptions& g, Action& run) {
         for (const auto& k : registry.kinds()) known += (known.empty() ? "" : ", ") + k;
         throw UsageError("unknown component type '" + o->kind + "' (known: " + known + ")");
       }
-      std::vector<runtime::RawParam> raw;
-      for (const auto& p : o->params) raw.push_back(runtime::parse_param_assignment(p, "--param " + p));
       const auto name = o->name.empty() ? o->kind : o->name;
       runtime::ResolvedComponent c;
       c.name = name;
       c.kind = o->kind;
       try {
+        std::vector<runtime::RawParam> raw;
+        for (const auto& p : o->params) raw.push_back(runtime::parse_param_assignment(p, "--param " + p));
         c.params = entry->info.params.resolve(raw, "component '" + name + "' (" + o->kind + ")");
       } catch (const runtime::ParamError& e) {
         throw UsageError(e.what());
       }
-      RunOptions ro;
-      ro.duration_s = o->duration;
-      ro.json = o->json;
-      return run_graph(registry, make_config(g), {c}, ro, nullptr);
+      return run_graph(registry, make_config(g), {c}, o->run, nullptr);
     };
   });
 }

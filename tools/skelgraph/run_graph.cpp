@@ -19,6 +19,14 @@ void print_reports(const runtime::Graph& graph, const char* when) {
 }
 }  // namespace
 
+void add_run_options(CLI::App& cmd, RunOptions& options) {
+  cmd.add_option("--duration", options.duration_s, "stop after this many seconds (default: until SIGINT/SIGTERM)")
+      ->check(kNonNegative);
+  cmd.add_option("--status-every", options.status_every_s, "print each component's status line every S seconds")
+      ->check(kNonNegative);
+  cmd.add_flag("--json", options.json, "print the final report as JSON on stdout");
+}
+
 int run_graph(const runtime::ComponentRegistry& registry, const runtime::DdsConfig& config,
               const std::vector<runtime::ResolvedComponent>& components, const RunOptions& options,
               const std::function<void(runtime::Graph&, nlohmann::json&)>& extra_report) {

@@ -11,6 +11,10 @@
 #include "skelgraph/runtime/graph.hpp"
 #include "skelgraph/runtime/launch_file.hpp"
 
+namespace CLI {
+class App;
+}
+
 namespace skelgraph::cli {
 
 struct RunOptions {
@@ -18,6 +22,9 @@ struct RunOptions {
   double status_every_s = 0.0;  // 0: only at start and end
   bool json = false;            // final report as JSON on stdout
 };
+
+// Adds --duration, --status-every and --json to a command that runs a graph.
+void add_run_options(CLI::App& cmd, RunOptions& options);
 
 // `extra_report` (optional) adds to the final JSON / text after the graph stopped.
 int run_graph(const runtime::ComponentRegistry& registry, const runtime::DdsConfig& config,

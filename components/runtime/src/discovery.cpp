@@ -38,38 +38,34 @@ void DiscoveryObserver::on_participant_discovery(eprosima::fastdds::dds::DomainP
   cv_.notify_all();
 }
 
-void DiscoveryObserver::on_publisher_discovery(eprosima::fastdds::dds::DomainParticipant*,
-                                               rtps::WriterDiscoveryInfo&& info) {
+namespace {
+// Writer and reader proxy data have the same accessors.
+template <class ProxyData>
+EndpointInfo endpoint_from(const ProxyData& d, bool is_writer) {
   EndpointInfo e;
-  e.guid = str(info.info.guid());
-  e.topic = info.info.topicName().to_string();
-  e.type_name = info.info.typeName().to_string();
-  e.is_writer = true;
-  e.keyed = info.info.topicKind() == rtps::WITH_KEY;
-  e.reliability = info.info.m_qos.m_reliability.kind == eprosima::fastdds::dds::RELIABLE_RELIABILITY_QOS
+  e.guid = str(d.guid());
+  e.topic = d.topicName().to_string();
+  e.type_name = d.typeName().to_string();
+  e.is_writer = is_writer;
+  e.keyed = d.topicKind() == rtps::WITH_KEY;
+  e.reliability = d.m_qos.m_reliability.kind == eprosima::fastdds::dds::RELIABLE_RELIABILITY_QOS
                       ? Reliability::Reliable
                       : Reliability::BestEffort;
-  e.durability = info.info.m_qos.m_durability.kind == eprosima::fastdds::dds::VOLATILE_DURABILITY_QOS
+  e.durability = d.m_qos.m_durability.kind == eprosima::fastdds::dds::VOLATILE_DURABILITY_QOS
                      ? Durability::Volatile
                      : Durability::TransientLocal;
-  upsert(std::move(e), info.status == rtps::WriterDiscoveryInfo::REMOVED_WRITER);
+  return e;
+}
+}  // namespace
+
+void DiscoveryObserver::on_publisher_discovery(eprosima::fastdds::dds::DomainParticipant*,
+                                               rtps::WriterDiscoveryInfo&& info) {
+  upsert(endpoint_from(info.info, true), info.status == rtps::WriterDiscoveryInfo::REMOVED_WRITER);
 }
 
 void DiscoveryObserver::on_subscriber_discovery(eprosima::fastdds::dds::DomainParticipant*,
                                                 rtps::ReaderDiscoveryInfo&& info) {
-  EndpointInfo e;
-  e.guid = str(info.info.guid());
-  e.topic = info.info.topicName().to_string();
-  e.type_name = info.info.typeName().to_string();
-  e.is_writer = false;
-  e.keyed = info.info.topicKind() == rtps::WITH_KEY;
-  e.reliability = info.info.m_qos.m_reliability.kind == eprosima::fastdds::dds::RELIABLE_RELIABILITY_QOS
-                      ? Reliability::Reliable
-                      : Reliability::BestEffort;
-  e.durability = info.info.m_qos.m_durability.kind == eprosima::fastdds::dds::VOLATILE_DURABILITY_QOS
-                     ? Durability::Volatile
-                     : Durability::TransientLocal;
-  upsert(std::move(e), info.status == rtps::ReaderDiscoveryInfo::REMOVED_READER);
+  upsert(endpoint_from(info.info, false), info.status == rtps::ReaderDiscoveryInfo::REMOVED_READER);
 }
 
 void DiscoveryObserver::upsert(EndpointInfo e, bool removed) {
