@@ -47,11 +47,14 @@ function(skelgraph_test name)
   endif()
 endfunction()
 
-# skelgraph_script_test(NAME SCRIPT ... ) — a shell test in its own loopback namespace.
+# skelgraph_script_test(NAME SCRIPT [ARGS ...]) — a shell test in its own loopback
+# namespace. The script gets the skelgraph program, then ARGS (helper programs
+# as $<TARGET_FILE:...>, a mode word).
 function(skelgraph_script_test name script)
+  cmake_parse_arguments(A "" "" "ARGS" ${ARGN})
   skelgraph_next_domain(domain)
   add_test(NAME ${name}
-    COMMAND ${PROJECT_SOURCE_DIR}/tests/netns-lo.sh bash ${script} $<TARGET_FILE:skelgraph>)
+    COMMAND ${PROJECT_SOURCE_DIR}/tests/netns-lo.sh bash ${script} $<TARGET_FILE:skelgraph> ${A_ARGS})
   set_tests_properties(${name} PROPERTIES
     ENVIRONMENT "SKELGRAPH_DOMAIN=${domain};SKELGRAPH_SOURCE_DIR=${PROJECT_SOURCE_DIR}"
     LABELS "integration" TIMEOUT 300)
