@@ -1,0 +1,65 @@
+#pragma once
+// The canonical skeleton every core works on: 15 joints as NITE names them,
+// Eigen types, no DDS. Sources map their own joint sets into this; the wire
+// type (msg::Skeleton) is converted at the adapter boundary (skeleton_msg.hpp).
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+
+namespace skelgraph::skeleton {
+
+// Same order as msg::JointId in idl/skelgraph.idl.
+enum class JointId : std::uint8_t {
+  Head,
+  Neck,
+  Torso,
+  LeftShoulder,
+  LeftElbow,
+  LeftHand,
+  RightShoulder,
+  RightElbow,
+  RightHand,
+  LeftHip,
+  LeftKnee,
+  LeftFoot,
+  RightHip,
+  RightKnee,
+  RightFoot
+};
+inline constexpr std::size_t kJointCount = 15;
+
+// "head", "left_shoulder", ... (the names used in JSON, CSV headers and launch files).
+const char* joint_name(JointId id);
+std::optional<JointId> joint_from_name(std::string_view name);
+inline constexpr JointId joint_at(std::size_t i) { return static_cast<JointId>(i); }
+
+// Tracker confidence as NITE and the Kinect SDK report it.
+inline constexpr float kTracked = 1.0f;
+inline constexpr float kInferred = 0.5f;
+inline constexpr float kLost = 0.0f;
+
+struct Joint {
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();         // metres
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
+  float confidence = kLost;
+  std::uint32_t sensor_mask = 0;  // fused output: which inputs contributed
+};
+
+struct Skeleton {
+  std::string sensor_id;
+  std::uint32_t person_id = 0;
+  std::string frame_id;            // "world" or the sensor's frame
+  std::int64_t stamp_ns = 0;       // on the source's clock
+  std::uint64_t frame_number = 0;
+  std::array<Joint, kJointCount> joints{};
+
+  Joint& operator[](JointId id) { return joints[static_cast<std::size_t>(id)]; }
+  const Joint& operator[](JointId id) const { return joints[static_cast<std::size_t>(id)]; }
+};
+
+}  // namespace skelgraph::skeleton
