@@ -1,0 +1,57 @@
+#pragma once
+// Readers for recorded skeleton data sets, mapping each format's joints into
+// the canonical 15 (tables in components/playback/README.md). A library: the
+// playback component and the offline tools use it alike, no DDS.
+
+#include <cstddef>
+#include <map>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "skelgraph/playback/csv.hpp"
+#include "skelgraph/skeleton/skeleton.hpp"
+
+namespace skelgraph::playback {
+
+enum class Format {
+  Generic,      // skelgraph's own CSV (write_generic_csv writes it)
+  KinderGator,  // Kinect v1, 20 joints, X/Y/Z, ms since midnight UTC
+  KinectV2,     // Kinect v2 body file (laban/): ticks, 25 joints x (X, Y, Z, TrackingState)
+};
+const char* format_name(Format f);  // "generic", "kinder-gator", "kinect-v2"
+std::optional<Format> format_from_name(std::string_view name);
+std::vector<std::string> format_names();
+
+struct ReadOptions {
+  enum class OnError { Stop, Skip };
+  OnError on_error = OnError::Stop;  // Stop: the first bad line throws DataError
+  std::string sensor_id;             // overrides the format's default sensor id
+};
+
+struct ReadReport {
+  std::size_t lines = 0;            // data lines read
+  std::size_t skipped = 0;          // bad lines skipped (OnError::Skip)
+  std::size_t repeated_stamps = 0;  // frames with the same stamp as the one before (kept)
+  std::vector<std::string> problems;  // the first 20 messages of skipped lines
+};
+
+struct Recording {
+  std::string format;
+  std::string source;                          // the file read
+  std::map<std::string, std::string> metadata;  // e.g. action, subject, gesture
+  std::vector<skeleton::Skeleton> frames;       // in time order
+  ReadReport report;
+};
+
+// Throws DataError (file:line: what was expected) on bad input under OnError::Stop.
+Recording read_recording(Format format, const std::string& path, const ReadOptions& options = {});
+
+// skelgraph's own CSV: "# skelgraph skeleton csv v1", "# key: value" metadata
+// lines, a header, then one row per skeleton with every joint's position,
+// orientation and confidence. Reading it back gives the same recording.
+void write_generic_csv(const Recording& recording, std::ostream& out);
+
+}  // namespace skelgraph::playback

@@ -1,0 +1,289 @@
+#include "skelgraph/playback/readers.hpp"
+
+#include <array>
+#include <cmath>
+#include <filesystem>
+#include <iomanip>
+#include <regex>
+
+namespace skelgraph::playback {
+
+namespace fs = std::filesystem;
+using skeleton::JointId;
+using skeleton::kJointCount;
+
+const char* format_name(Format f) {
+  switch (f) {
+    case Format::Generic: return "generic";
+    case Format::KinderGator: return "kinder-gator";
+    case Format::KinectV2: return "kinect-v2";
+  }
+  return "?";
+}
+
+std::vector<std::string> format_names() { return {"generic", "kinder-gator", "kinect-v2"}; }
+
+std::optional<Format> format_from_name(std::string_view name) {
+  for (auto f : {Format::Generic, Format::KinderGator, Format::KinectV2}) {
+    if (name == format_name(f)) return f;
+  }
+  return std::nullopt;
+}
+
+namespace {
+
+constexpr std::size_t kMaxProblems = 20;
+
+// Reads every data row with the error policy applied: `parse` turns one row
+// into zero or more skeletons (appended to rec.frames) or throws DataError.
+template <class Parse>
+void read_rows(CsvReader& csv, const ReadOptions& opt, Recording& rec, Parse parse) {
+  std::vector<std::string> fields;
+  while (csv.next(fields)) {
+    ++rec.report.lines;
+    const auto before = rec.frames.size();
+    try {
+      parse(fields);
+      for (auto i = std::max<std::size_t>(before, 1); i < rec.frames.size(); ++i) {
+        const auto prev = rec.frames[i - 1].stamp_ns, now = rec.frames[i].stamp_ns;
+        if (now < prev) {
+          csv.fail("time goes backwards (" + std::to_string(now) + " ns after " + std::to_string(prev) +
+                   " ns); expected non-decreasing timestamps");
+        }
+        if (now == prev && i >= before) ++rec.report.repeated_stamps;
+      }
+    } catch (const DataError& e) {
+      if (opt.on_error == ReadOptions::OnError::Stop) throw;
+      rec.frames.resize(before);
+      ++rec.report.skipped;
+      if (rec.report.problems.size() < kMaxProblems) rec.report.problems.push_back(e.what());
+    }
+  }
+}
+
+void expect_fields(const CsvReader& csv, const std::vector<std::string>& f, std::size_t n, const char* what) {
+  if (f.size() != n) {
+    csv.fail("expected " + std::to_string(n) + " fields (" + what + "), got " + std::to_string(f.size()));
+  }
+}
+
+Eigen::Vector3d xyz(const CsvReader& csv, const std::vector<std::string>& f, std::size_t i, const std::string& name) {
+  return {csv.number(f, i, name + "X"), csv.number(f, i + 1, name + "Y"), csv.number(f, i + 2, name + "Z")};
+}
+
+// ---- Kinder-Gator (Kinect v1, NUI joint order) ----
+
+const std::array<const char*, 20> kV1Joints = {
+    "HipCenter", "Spine",    "ShoulderCenter", "Head",       "ShoulderLeft", "ElbowLeft", "WristLeft",
+    "HandLeft",  "ShoulderRight", "ElbowRight", "WristRight", "HandRight",   "HipLeft",   "KneeLeft",
+    "AnkleLeft", "FootLeft", "HipRight",       "KneeRight",  "AnkleRight",   "FootRight"};
+// Canonical joint i comes from Kinect v1 joint kV1Map[i].
+const std::array<std::size_t, kJointCount> kV1Map = {3, 2, 1, 4, 5, 7, 8, 9, 11, 12, 13, 15, 16, 17, 19};
+
+Recording read_kinder_gator(const std::string& path, const ReadOptions& opt) {
+  Recording rec;
+  rec.format = format_name(Format::KinderGator);
+  rec.source = path;
+  CsvReader csv(path);
+  std::vector<std::string> header;
+  if (!csv.next(header)) csv.fail("empty file; expected a header starting with 'Timestamp'");
+  expect_fields(csv, header, 63, "Timestamp, 20 joints x X/Y/Z, User-ID, Action");
+  if (header[0] != "Timestamp") csv.fail("expected the header to start with 'Timestamp', got '" + header[0] + "'");
+  for (std::size_t j = 0; j < kV1Joints.size(); ++j) {
+    const std::string want = std::string(kV1Joints[j]) + "X";
+    if (header[1 + 3 * j] != want) {
+      csv.fail("expected column " + std::to_string(2 + 3 * j) + " to be '" + want + "', got '" + header[1 + 3 * j] + "'");
+    }
+  }
+  // Timestamps are ms since midnight UTC; the file name's Unix ms gives the day.
+  std::int64_t day_ns = 0;
+  std::smatch m;
+  const auto name = fs::path(path).filename().string();
+  if (std::regex_search(name, m, std::regex("-([0-9]{13})\\.csv$"))) {
+    const auto file_ms = std::stoll(m[1].str());
+    day_ns = (file_ms / 86'400'000LL) * 86'400'000LL * 1'000'000LL;
+  }
+  const std::string sensor = opt.sensor_id.empty() ? "kinect_v1" : opt.sensor_id;
+  read_rows(csv, opt, rec, [&](const std::vector<std::string>& f) {
+    expect_fields(csv, f, 63, "Timestamp, 20 joints x X/Y/Z, User-ID, Action");
+    skeleton::Skeleton s;
+    s.sensor_id = sensor;
+    s.frame_id = sensor;
+    s.stamp_ns = day_ns + static_cast<std::int64_t>(std::llround(csv.number(f, 0, "Timestamp") * 1e6));
+    s.frame_number = rec.frames.size();
+    for (std::size_t i = 0; i < kJointCount; ++i) {
+      const auto src = kV1Map[i];
+      s.joints[i].position = xyz(csv, f, 1 + 3 * src, kV1Joints[src]);
+      s.joints[i].confidence = skeleton::kTracked;  // the format has no tracking state
+    }
+    if (rec.metadata.empty()) {
+      rec.metadata["subject"] = f[61];
+      rec.metadata["action"] = f[62];
+    }
+    rec.frames.push_back(std::move(s));
+  });
+  return rec;
+}
+
+// ---- Kinect v2 body file (JointType order, with TrackingState) ----
+
+const std::array<const char*, 25> kV2Joints = {
+    "SpineBase",  "SpineMid",  "Neck",      "Head",         "ShoulderLeft", "ElbowLeft",  "WristLeft",
+    "HandLeft",   "ShoulderRight", "ElbowRight", "WristRight", "HandRight",  "HipLeft",    "KneeLeft",
+    "AnkleLeft",  "FootLeft",  "HipRight",  "KneeRight",    "AnkleRight",   "FootRight",  "SpineShoulder",
+    "HandTipLeft", "ThumbLeft", "HandTipRight", "ThumbRight"};
+// Neck is SpineShoulder (between the shoulders, where NITE and Kinect v1 put it),
+// torso is SpineMid.
+const std::array<std::size_t, kJointCount> kV2Map = {3, 20, 1, 4, 5, 7, 8, 9, 11, 12, 13, 15, 16, 17, 19};
+
+Recording read_kinect_v2(const std::string& path, const ReadOptions& opt) {
+  Recording rec;
+  rec.format = format_name(Format::KinectV2);
+  rec.source = path;
+  CsvReader csv(path);
+  std::smatch m;
+  const auto stem = fs::path(path).stem().string();
+  if (std::regex_match(stem, m, std::regex("Ges[0-9]+_(.+)"))) rec.metadata["gesture"] = m[1].str();
+  const std::string sensor = opt.sensor_id.empty() ? "kinect_v2" : opt.sensor_id;
+  read_rows(csv, opt, rec, [&](const std::vector<std::string>& f) {
+    expect_fields(csv, f, 101, "Timestamp, 25 joints x X/Y/Z/TrackingState");
+    skeleton::Skeleton s;
+    s.sensor_id = sensor;
+    s.frame_id = sensor;
+    s.stamp_ns = csv.integer(f, 0, "Timestamp") * 100;  // 100-ns sensor ticks
+    s.frame_number = rec.frames.size();
+    for (std::size_t i = 0; i < kJointCount; ++i) {
+      const auto src = kV2Map[i];
+      const auto col = 1 + 4 * src;
+      s.joints[i].position = xyz(csv, f, col, kV2Joints[src]);
+      const auto state = csv.integer(f, col + 3, std::string(kV2Joints[src]) + "TrackingState");
+      if (state < 0 || state > 2) {
+        csv.fail(std::string(kV2Joints[src]) + "TrackingState expects 0, 1 or 2, got " + std::to_string(state));
+      }
+      s.joints[i].confidence = state == 2 ? skeleton::kTracked : state == 1 ? skeleton::kInferred : skeleton::kLost;
+    }
+    rec.frames.push_back(std::move(s));
+  });
+  return rec;
+}
+
+// ---- skelgraph generic CSV ----
+
+constexpr const char* kGenericMagic = "# skelgraph skeleton csv v1";
+const std::array<const char*, 8> kJointFields = {"x", "y", "z", "qw", "qx", "qy", "qz", "conf"};
+
+Recording read_generic(const std::string& path, const ReadOptions& opt) {
+  Recording rec;
+  rec.format = format_name(Format::Generic);
+  rec.source = path;
+  // Metadata comments come first; CsvReader sees them as one-field lines.
+  CsvReader csv(path);
+  std::vector<std::string> f;
+  if (!csv.next(f) || f.size() != 1 || f[0] != kGenericMagic) {
+    csv.fail(std::string("expected the first line to be '") + kGenericMagic + "'");
+  }
+  std::vector<std::string> header;
+  while (csv.next(f)) {
+    if (f.size() == 1 && f[0].rfind("#", 0) == 0) {
+      const auto colon = f[0].find(':');
+      if (colon == std::string::npos) csv.fail("expected a metadata line '# key: value'");
+      auto key = f[0].substr(1, colon - 1);
+      auto value = f[0].substr(colon + 1);
+      key.erase(0, key.find_first_not_of(' '));
+      value.erase(0, value.find_first_not_of(' '));
+      rec.metadata[key] = value;
+      continue;
+    }
+    header = f;
+    break;
+  }
+  if (header.empty()) csv.fail("no header line");
+  // Column positions by name; every column must be known.
+  std::map<std::string, std::size_t> col;
+  for (std::size_t i = 0; i < header.size(); ++i) {
+    if (!col.emplace(header[i], i).second) csv.fail("column '" + header[i] + "' appears twice");
+  }
+  const std::vector<std::string> required_base = {"stamp_ns", "sensor_id", "person_id"};
+  std::vector<std::string> known = {"stamp_ns", "sensor_id", "person_id", "frame_id", "frame_number"};
+  for (std::size_t j = 0; j < kJointCount; ++j) {
+    for (const auto* suffix : kJointFields) known.push_back(std::string(skeleton::joint_name(skeleton::joint_at(j))) + "_" + suffix);
+  }
+  for (const auto& h : header) {
+    if (std::find(known.begin(), known.end(), h) == known.end()) csv.fail("unknown column '" + h + "'");
+  }
+  for (const auto& r : required_base) {
+    if (!col.count(r)) csv.fail("missing column '" + r + "'");
+  }
+  for (std::size_t j = 0; j < kJointCount; ++j) {
+    const std::string n = skeleton::joint_name(skeleton::joint_at(j));
+    for (const auto* s : {"x", "y", "z", "conf"}) {
+      if (!col.count(n + "_" + s)) csv.fail("missing column '" + n + "_" + s + "'");
+    }
+  }
+  const auto opt_col = [&](const std::string& name) -> std::optional<std::size_t> {
+    const auto it = col.find(name);
+    return it == col.end() ? std::nullopt : std::optional<std::size_t>(it->second);
+  };
+  read_rows(csv, opt, rec, [&](const std::vector<std::string>& row) {
+    expect_fields(csv, row, header.size(), "one per header column");
+    skeleton::Skeleton s;
+    s.stamp_ns = csv.integer(row, col["stamp_ns"], "stamp_ns");
+    s.sensor_id = opt.sensor_id.empty() ? row[col["sensor_id"]] : opt.sensor_id;
+    const auto person = csv.integer(row, col["person_id"], "person_id");
+    if (person < 0 || person > 0xffffffffLL) csv.fail("person_id expects 0..4294967295, got " + row[col["person_id"]]);
+    s.person_id = static_cast<std::uint32_t>(person);
+    if (auto c = opt_col("frame_id")) s.frame_id = row[*c];
+    if (auto c = opt_col("frame_number")) s.frame_number = static_cast<std::uint64_t>(csv.integer(row, *c, "frame_number"));
+    for (std::size_t j = 0; j < kJointCount; ++j) {
+      const std::string n = skeleton::joint_name(skeleton::joint_at(j));
+      auto& joint = s.joints[j];
+      joint.position = {csv.number(row, col[n + "_x"], n + "_x"), csv.number(row, col[n + "_y"], n + "_y"),
+                        csv.number(row, col[n + "_z"], n + "_z")};
+      if (auto qw = opt_col(n + "_qw")) {
+        joint.orientation = Eigen::Quaterniond(csv.number(row, *qw, n + "_qw"), csv.number(row, col[n + "_qx"], n + "_qx"),
+                                               csv.number(row, col[n + "_qy"], n + "_qy"), csv.number(row, col[n + "_qz"], n + "_qz"));
+      }
+      const double conf = csv.number(row, col[n + "_conf"], n + "_conf");
+      if (conf < 0.0 || conf > 1.0) csv.fail(n + "_conf expects a confidence in [0, 1], got " + row[col[n + "_conf"]]);
+      joint.confidence = static_cast<float>(conf);
+    }
+    rec.frames.push_back(std::move(s));
+  });
+  return rec;
+}
+
+}  // namespace
+
+Recording read_recording(Format format, const std::string& path, const ReadOptions& options) {
+  switch (format) {
+    case Format::Generic: return read_generic(path, options);
+    case Format::KinderGator: return read_kinder_gator(path, options);
+    case Format::KinectV2: return read_kinect_v2(path, options);
+  }
+  throw std::invalid_argument("unknown format");
+}
+
+void write_generic_csv(const Recording& rec, std::ostream& out) {
+  out << kGenericMagic << "\n";
+  for (const auto& [k, v] : rec.metadata) out << "# " << k << ": " << v << "\n";
+  out << "stamp_ns,sensor_id,person_id,frame_id,frame_number";
+  for (std::size_t j = 0; j < kJointCount; ++j) {
+    for (const auto* suffix : kJointFields) out << "," << skeleton::joint_name(skeleton::joint_at(j)) << "_" << suffix;
+  }
+  out << "\n" << std::setprecision(17);
+  for (const auto& s : rec.frames) {
+    for (const auto* id : {&s.sensor_id, &s.frame_id}) {
+      if (id->find_first_of(",\r\n") != std::string::npos) {
+        throw std::invalid_argument("generic CSV: id '" + *id + "' contains a comma or line break");
+      }
+    }
+    out << s.stamp_ns << "," << s.sensor_id << "," << s.person_id << "," << s.frame_id << "," << s.frame_number;
+    for (const auto& j : s.joints) {
+      out << "," << j.position.x() << "," << j.position.y() << "," << j.position.z() << "," << j.orientation.w() << ","
+          << j.orientation.x() << "," << j.orientation.y() << "," << j.orientation.z() << "," << j.confidence;
+    }
+    out << "\n";
+  }
+}
+
+}  // namespace skelgraph::playback

@@ -1,0 +1,269 @@
+// Data-set readers on hand-made files (good and broken) and on the real
+// recordings in ../shared/data.
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+#include "skelgraph/playback/readers.hpp"
+
+using namespace skelgraph;
+using namespace skelgraph::playback;
+using skeleton::JointId;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string write_file(const std::string& name, const std::string& text) {
+  const auto path = ::testing::TempDir() + "/" + name;
+  std::ofstream(path, std::ios::binary) << text;
+  return path;
+}
+
+// A Kinder-Gator header and a row whose joint j sits at (j, 10 + j, 100 + j) / 100.
+std::string kg_header() {
+  const char* joints[] = {"HipCenter", "Spine",     "ShoulderCenter", "Head",      "ShoulderLeft",
+                          "ElbowLeft", "WristLeft", "HandLeft",       "ShoulderRight", "ElbowRight",
+                          "WristRight", "HandRight", "HipLeft",       "KneeLeft",  "AnkleLeft",
+                          "FootLeft",  "HipRight",  "KneeRight",      "AnkleRight", "FootRight"};
+  std::string h = "Timestamp,";
+  for (const auto* j : joints) h += std::string(j) + "X," + j + "Y," + j + "Z,";
+  return h + "User-ID,Action,\n";
+}
+std::string kg_row(double ms, const std::string& override_field = {}, int override_index = -1) {
+  std::ostringstream os;
+  os << std::setprecision(12) << ms << ",";
+  for (int j = 0; j < 20; ++j) {
+    for (int k = 0; k < 3; ++k) {
+      const int idx = 1 + 3 * j + k;
+      if (idx == override_index) {
+        os << override_field << ",";
+      } else {
+        os << (j + 10 * k) / 100.0 << ",";
+      }
+    }
+  }
+  os << "565,Point-at-the-camera,\n";
+  return os.str();
+}
+
+std::string data_dir() {
+  if (const char* d = std::getenv("SKELGRAPH_DATA_DIR")) return d;
+  const char* src = std::getenv("SKELGRAPH_SOURCE_DIR");
+  return std::string(src ? src : ".") + "/../shared/data";
+}
+
+}  // namespace
+
+TEST(Readers, KinderGatorMapsJointsAndKeepsLabels) {
+  const auto path = write_file("POSE-p565_01-Point-at-the-camera-1469182494249.csv",
+                               kg_header() + kg_row(48000000.5) + kg_row(48000033.25));
+  const auto rec = read_recording(Format::KinderGator, path);
+  ASSERT_EQ(rec.frames.size(), 2u);
+  EXPECT_EQ(rec.metadata.at("action"), "Point-at-the-camera");
+  EXPECT_EQ(rec.metadata.at("subject"), "565");
+  const auto& s = rec.frames[1];
+  EXPECT_EQ(s.sensor_id, "kinect_v1");
+  // Head is Kinect v1 joint 3, the right hand joint 11, the neck ShoulderCenter (2).
+  EXPECT_DOUBLE_EQ(s[JointId::Head].position.x(), 0.03);
+  EXPECT_DOUBLE_EQ(s[JointId::Head].position.y(), 0.13);
+  EXPECT_DOUBLE_EQ(s[JointId::RightHand].position.z(), 0.31);
+  EXPECT_DOUBLE_EQ(s[JointId::Neck].position.x(), 0.02);
+  EXPECT_EQ(s[JointId::LeftFoot].confidence, skeleton::kTracked);
+  // ms since midnight UTC on the day of the file name's Unix time (2016-07-22).
+  const std::int64_t day_ns = 1469145600000LL * 1000000LL;
+  EXPECT_EQ(rec.frames[0].stamp_ns, day_ns + 48000000500000LL);
+  EXPECT_EQ(rec.frames[1].stamp_ns - rec.frames[0].stamp_ns, 32750000);
+}
+
+TEST(Readers, BadLinesNameFileLineAndExpectation) {
+  auto error = [](const std::string& body, const std::string& name) {
+    const auto path = write_file(name, body);
+    try {
+      read_recording(Format::KinderGator, path);
+    } catch (const DataError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(error(kg_header() + kg_row(1) + kg_row(2, "abc", 16), "kg_a.csv")
+                .find("kg_a.csv:3: column 'ElbowLeftX' expects a number, got 'abc'"),
+            std::string::npos);
+  EXPECT_NE(error(kg_header() + kg_row(1, "nan", 4), "kg_b.csv").find("expects a finite number, got 'nan'"),
+            std::string::npos);
+  EXPECT_NE(error(kg_header() + kg_row(1, "inf", 4), "kg_c.csv").find("finite"), std::string::npos);
+  EXPECT_NE(error(kg_header() + "1,2,3\n", "kg_d.csv").find("kg_d.csv:2: expected 63 fields"), std::string::npos);
+  EXPECT_NE(error(kg_header() + kg_row(5) + kg_row(4), "kg_e.csv").find("kg_e.csv:3: time goes backwards"),
+            std::string::npos);
+  EXPECT_NE(error("Time,A\n", "kg_f.csv").find("kg_f.csv:1: expected 63 fields"), std::string::npos);
+  EXPECT_NE(error("", "kg_g.csv").find("empty file"), std::string::npos);
+  try {
+    read_recording(Format::KinderGator, ::testing::TempDir() + "/nope.csv");
+    FAIL();
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("nope.csv:0: cannot open file"), std::string::npos);
+  }
+}
+
+TEST(Readers, SkipPolicyKeepsGoodLinesAndReportsBadOnes) {
+  const auto path = write_file("kg_skip.csv", kg_header() + kg_row(1) + kg_row(2, "x", 7) + "oops\n" + kg_row(3) +
+                                                  kg_row(2) + kg_row(4) + kg_row(4));
+  ReadOptions opt;
+  opt.on_error = ReadOptions::OnError::Skip;
+  const auto rec = read_recording(Format::KinderGator, path, opt);
+  ASSERT_EQ(rec.frames.size(), 4u);  // 1, 3, 4, 4
+  EXPECT_EQ(rec.report.lines, 7u);
+  EXPECT_EQ(rec.report.skipped, 3u);  // bad number, short line, time backwards
+  EXPECT_EQ(rec.report.repeated_stamps, 1u);
+  ASSERT_EQ(rec.report.problems.size(), 3u);
+  EXPECT_NE(rec.report.problems[0].find("kg_skip.csv:3:"), std::string::npos);
+  EXPECT_NE(rec.report.problems[2].find("kg_skip.csv:6: time goes backwards"), std::string::npos);
+}
+
+TEST(Readers, KinectV2TrackingStatesBecomeConfidence) {
+  std::ostringstream os;
+  for (int frame = 0; frame < 2; ++frame) {
+    os << 97771535532LL + frame * 333333;
+    for (int j = 0; j < 25; ++j) os << "," << j * 0.1 << "," << 1.0 + j * 0.01 << "," << 2.5 << "," << (j == 7 ? 1 : j == 11 ? 0 : 2);
+    os << ",\r\n";  // trailing comma, CRLF
+  }
+  const auto path = write_file("Ges05_demopoint.csv", os.str());
+  const auto rec = read_recording(Format::KinectV2, path);
+  ASSERT_EQ(rec.frames.size(), 2u);
+  EXPECT_EQ(rec.metadata.at("gesture"), "demopoint");
+  const auto& s = rec.frames[0];
+  EXPECT_EQ(s[JointId::LeftHand].confidence, skeleton::kInferred);  // HandLeft = 7
+  EXPECT_EQ(s[JointId::RightHand].confidence, skeleton::kLost);     // HandRight = 11
+  EXPECT_EQ(s[JointId::Head].confidence, skeleton::kTracked);
+  EXPECT_DOUBLE_EQ(s[JointId::Neck].position.x(), 2.0);  // SpineShoulder = 20
+  EXPECT_DOUBLE_EQ(s[JointId::Torso].position.x(), 0.1);  // SpineMid = 1
+  EXPECT_EQ(rec.frames[1].stamp_ns - rec.frames[0].stamp_ns, 33333300);
+
+  const auto bad = write_file("v2_bad.csv", "5" + std::string(",0,0,0,3") + std::string(24 * 8, ' ') + "\n");
+  EXPECT_THROW(read_recording(Format::KinectV2, bad), DataError);
+  std::string state3 = "5";
+  for (int j = 0; j < 25; ++j) state3 += ",0,0,1," + std::string(j == 3 ? "3" : "2");
+  try {
+    read_recording(Format::KinectV2, write_file("v2_state.csv", state3 + "\n"));
+    FAIL();
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("v2_state.csv:1: HeadTrackingState expects 0, 1 or 2, got 3"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(Readers, GenericCsvRoundTripsEverything) {
+  Recording rec;
+  rec.metadata["action"] = "point";
+  rec.metadata["subject"] = "s1";
+  for (int i = 0; i < 3; ++i) {
+    skeleton::Skeleton s;
+    s.sensor_id = "kinect_" + std::to_string(i % 2);
+    s.person_id = static_cast<std::uint32_t>(i);
+    s.frame_id = "world";
+    s.stamp_ns = 1'000'000'000LL + i * 33'333'333LL;
+    s.frame_number = static_cast<std::uint64_t>(10 + i);
+    for (std::size_t j = 0; j < skeleton::kJointCount; ++j) {
+      s.joints[j].position = {0.1 * j + 1e-9 * i, -0.2 * j, 2.0 + 1.0 / 3.0};
+      s.joints[j].orientation = Eigen::Quaterniond(Eigen::AngleAxisd(0.1 * j, Eigen::Vector3d::UnitY()));
+      s.joints[j].confidence = j % 3 == 0 ? 0.5f : 1.0f;
+    }
+    rec.frames.push_back(s);
+  }
+  std::ostringstream out;
+  write_generic_csv(rec, out);
+  const auto path = write_file("generic.csv", out.str());
+  const auto back = read_recording(Format::Generic, path);
+  EXPECT_EQ(back.metadata, rec.metadata);
+  ASSERT_EQ(back.frames.size(), rec.frames.size());
+  for (std::size_t i = 0; i < rec.frames.size(); ++i) {
+    const auto& a = rec.frames[i];
+    const auto& b = back.frames[i];
+    EXPECT_EQ(a.sensor_id, b.sensor_id);
+    EXPECT_EQ(a.person_id, b.person_id);
+    EXPECT_EQ(a.frame_id, b.frame_id);
+    EXPECT_EQ(a.stamp_ns, b.stamp_ns);
+    EXPECT_EQ(a.frame_number, b.frame_number);
+    for (std::size_t j = 0; j < skeleton::kJointCount; ++j) {
+      EXPECT_EQ(a.joints[j].position, b.joints[j].position);  // bit-exact (17 digits)
+      EXPECT_EQ(a.joints[j].orientation.coeffs(), b.joints[j].orientation.coeffs());
+      EXPECT_EQ(a.joints[j].confidence, b.joints[j].confidence);
+    }
+  }
+}
+
+TEST(Readers, GenericCsvRejectsUnknownAndMissingColumns) {
+  auto error = [](const std::string& text) {
+    try {
+      read_recording(Format::Generic, write_file("g.csv", text));
+    } catch (const DataError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(error("stamp_ns,sensor_id\n").find("g.csv:1: expected the first line to be '# skelgraph skeleton csv v1'"),
+            std::string::npos);
+  EXPECT_NE(error("# skelgraph skeleton csv v1\nstamp_ns,sensor_id,person_id,colour\n").find("unknown column 'colour'"),
+            std::string::npos);
+  EXPECT_NE(error("# skelgraph skeleton csv v1\nstamp_ns,sensor_id,person_id\n").find("missing column 'head_x'"),
+            std::string::npos);
+  EXPECT_NE(error("# skelgraph skeleton csv v1\n# no colon\n").find("g.csv:2: expected a metadata line"),
+            std::string::npos);
+}
+
+TEST(Readers, FormatNames) {
+  for (const auto& n : format_names()) {
+    ASSERT_TRUE(format_from_name(n).has_value()) << n;
+    EXPECT_EQ(format_name(*format_from_name(n)), n);
+  }
+  EXPECT_FALSE(format_from_name("bvh").has_value());
+}
+
+// ---- the real recordings in ../shared/data (never copied into the project) ----
+
+TEST(SharedData, KinderGatorAdultsAllReadWithTheDocumentedFrameCount) {
+  const auto dir = fs::path(data_dir()) / "kinder-gator" / "adults";
+  ASSERT_TRUE(fs::is_directory(dir)) << dir << " is missing: tests read ../shared/data (or SKELGRAPH_DATA_DIR)";
+  std::size_t files = 0, frames = 0, facing = 0, head_above_torso = 0;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    if (e.path().extension() != ".csv") continue;
+    const auto rec = read_recording(Format::KinderGator, e.path().string());
+    ++files;
+    frames += rec.frames.size();
+    EXPECT_FALSE(rec.metadata.at("action").empty());
+    for (const auto& s : rec.frames) {
+      facing += s[JointId::LeftShoulder].position.x() < s[JointId::RightShoulder].position.x() ? 1 : 0;
+      head_above_torso += s[JointId::Head].position.y() > s[JointId::Torso].position.y() ? 1 : 0;
+      EXPECT_GT(s[JointId::Torso].position.z(), 1.0);  // metres from the sensor
+      EXPECT_LT(s[JointId::Torso].position.z(), 4.5);
+    }
+  }
+  EXPECT_EQ(files, 160u);
+  EXPECT_EQ(frames, 26675u);      // the data set's README
+  EXPECT_EQ(facing, frames);      // README: ShoulderLeft X < ShoulderRight X in every frame
+  EXPECT_EQ(head_above_torso, frames);  // y up
+}
+
+TEST(SharedData, LabanKinectV2FilesRead) {
+  const auto dir = fs::path(data_dir()) / "laban";
+  ASSERT_TRUE(fs::is_directory(dir)) << dir << " is missing";
+  std::size_t files = 0;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    const auto name = e.path().filename().string();
+    if (e.path().extension() != ".csv") continue;
+    const auto rec = read_recording(Format::KinectV2, e.path().string());
+    ++files;
+    ASSERT_GT(rec.frames.size(), 10u) << name;
+    // Ges<NN>_<gesture>.csv carry their label; joints.csv is the unlabelled sample.
+    EXPECT_EQ(rec.metadata.count("gesture"), name.rfind("Ges", 0) == 0 ? 1u : 0u) << name;
+    for (const auto& s : rec.frames) {
+      EXPECT_GT(s[JointId::Head].position.y(), s[JointId::Torso].position.y()) << name;
+      EXPECT_GT(s[JointId::Head].confidence, 0.0f) << name;  // README: state 0 never occurs
+    }
+  }
+  EXPECT_EQ(files, 7u);
+}
