@@ -69,7 +69,7 @@ int run(double duration_s) {
     // The writer fills its discovery data from the type support when it is
     // created, so the topic (policy applied) comes first, then the override,
     // then the writer; Publisher reuses the topic as it is.
-    ctx.topic(runtime::topics::kSkeletonRaw.name, new msg::SkeletonPubSubType());
+    ctx.topic(runtime::topics::kSkeletonRaw.name, runtime::make_type_support<msg::Skeleton>());
     ctx.participant().find_type(msg::MessageTraits<msg::Skeleton>::name)->auto_fill_type_object(true);
     std::fprintf(stderr, "publish_skeleton: announcing the full TypeObject (rejected configuration)\n");
   }

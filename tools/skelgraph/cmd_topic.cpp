@@ -101,7 +101,6 @@ int echo(const runtime::DdsConfig& config, const std::string& topic, std::size_t
   const auto plan = plan_for(topic, s, seconds(timeout_s));
   const auto* info = msg::find_message(plan.type_name);
   std::mutex mutex;
-  std::condition_variable cv;
   std::size_t printed = 0;
   runtime::RawSubscription sub(
       *s.context, topic, plan.type_name, plan.keyed, plan.qos,
@@ -126,7 +125,6 @@ int echo(const runtime::DdsConfig& config, const std::string& topic, std::size_t
         }
         std::fflush(stdout);
         ++printed;
-        cv.notify_all();
       });
   s.context->executor().start();
   const auto deadline_first = std::chrono::steady_clock::now() + seconds(timeout_s);

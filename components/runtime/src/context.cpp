@@ -114,7 +114,6 @@ dds::Topic& Context::topic(const std::string& name, dds::TopicDataType* support)
     }
     return *it->second;
   }
-  apply_type_policy(*support);
   const auto registered = participant_->find_type(type.get_type_name());
   if (registered.empty()) {
     if (participant_->register_type(type) != ReturnCode_t::RETCODE_OK) {

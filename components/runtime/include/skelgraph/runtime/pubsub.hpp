@@ -13,6 +13,7 @@
 #include "skelgraph/msg/raw_type.hpp"
 #include "skelgraph/runtime/context.hpp"
 #include "skelgraph/runtime/topics.hpp"
+#include "skelgraph/runtime/type_policy.hpp"
 
 namespace eprosima::fastdds::dds {
 class DataWriter;
@@ -65,11 +66,20 @@ class ReaderBase {
   std::shared_ptr<State> state_;
 };
 
+// Type support for a generated type, announcing what type_policy decides.
+// (RawPubSubType announces nothing, so tools match any revision by name.)
+template <class T>
+eprosima::fastdds::dds::TopicDataType* make_type_support() {
+  auto* support = new typename msg::MessageTraits<T>::PubSubType();
+  apply_type_policy(*support);
+  return support;
+}
+
 template <class T>
 class Publisher {
  public:
   Publisher(Context& ctx, const TopicDef<T>& topic)
-      : base_(ctx, topic.name, new typename msg::MessageTraits<T>::PubSubType(), topic.qos) {}
+      : base_(ctx, topic.name, make_type_support<T>(), topic.qos) {}
   bool publish(const T& sample) { return base_.write(const_cast<T*>(&sample)); }
   std::size_t matched() const { return base_.matched(); }
   bool wait_for_matched(std::size_t n, std::chrono::milliseconds timeout) const {
@@ -86,7 +96,7 @@ class Subscription {
  public:
   using Callback = std::function<void(const T&, const SampleMeta&)>;
   Subscription(Context& ctx, const TopicDef<T>& topic, Callback cb)
-      : base_(ctx, topic.name, new typename msg::MessageTraits<T>::PubSubType(), topic.qos,
+      : base_(ctx, topic.name, make_type_support<T>(), topic.qos,
               [cb = std::move(cb)](void* s, const SampleMeta& m) { cb(*static_cast<const T*>(s), m); }) {}
   std::size_t matched() const { return base_.matched(); }
   bool wait_for_matched(std::size_t n, std::chrono::milliseconds timeout) const {

@@ -12,7 +12,7 @@ namespace skelgraph::runtime {
 
 // Registers the generated TypeObjects with Fast DDS's TypeObjectFactory (once).
 void register_type_objects();
-// Sets what `support` announces; called for every type a Context registers.
+// Sets what `support` announces; applied to every generated type (make_type_support).
 void apply_type_policy(eprosima::fastdds::dds::TopicDataType& support);
 // Participant side: answers TypeLookup requests so tools can fetch our types.
 void apply_type_policy(eprosima::fastdds::dds::DomainParticipantQos& qos);
