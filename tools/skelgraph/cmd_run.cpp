@@ -26,9 +26,7 @@ void add_run_command(CLI::App& app, GlobalOptions& g, Action& run) {
       runtime::register_builtin_components(registry);
       const auto* entry = registry.find(o->kind);
       if (entry == nullptr) {
-        std::string known;
-        for (const auto& k : registry.kinds()) known += (known.empty() ? "" : ", ") + k;
-        throw UsageError("unknown component type '" + o->kind + "' (known: " + known + ")");
+        throw UsageError("unknown component type '" + o->kind + "' (known: " + registry.kinds_text() + ")");
       }
       const auto name = o->name.empty() ? o->kind : o->name;
       runtime::ResolvedComponent c;

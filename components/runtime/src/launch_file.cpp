@@ -149,10 +149,8 @@ std::vector<ResolvedComponent> resolve_launch(const LaunchSpec& spec, const Comp
     if (!host.empty() && std::find(c.hosts.begin(), c.hosts.end(), host) == c.hosts.end()) continue;
     const auto* entry = registry.find(c.kind);
     if (entry == nullptr) {
-      std::string known;
-      for (const auto& k : registry.kinds()) known += (known.empty() ? "" : ", ") + k;
       errors.push_back(c.origin + ": component '" + c.name + "' has unknown type '" + c.kind +
-                       "' (known: " + known + ")");
+                       "' (known: " + registry.kinds_text() + ")");
       continue;
     }
     try {

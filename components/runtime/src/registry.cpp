@@ -25,4 +25,10 @@ std::vector<std::string> ComponentRegistry::kinds() const {
   return out;
 }
 
+std::string ComponentRegistry::kinds_text() const {
+  std::string out;
+  for (const auto& k : kinds()) out += (out.empty() ? "" : ", ") + k;
+  return out;
+}
+
 }  // namespace skelgraph::runtime

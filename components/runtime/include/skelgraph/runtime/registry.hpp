@@ -45,6 +45,7 @@ class ComponentRegistry {
 
   const Entry* find(const std::string& kind) const;
   std::vector<std::string> kinds() const;  // sorted
+  std::string kinds_text() const;          // "monitor, sync_master" for messages
   const std::vector<Entry>& entries() const { return entries_; }
 
  private:
