@@ -56,13 +56,13 @@ void add_demo_command(CLI::App& app, GlobalOptions& g, Action& run) {
                          if (o->json) return;
                          for (const auto& s : seen["sessions"]) {
                            std::printf(
-                               "session %u '%s': START %s, %llu ticks at %.2f Hz (period %.1f-%.1f ms, std %.2f ms), "
+                               "session %u '%s': START %s, %llu ticks at %.2f Hz (arrival period %.1f-%.1f ms, std %.2f ms), "
                                "%llu missing, STOP %s\n",
                                s["session_id"].get<unsigned>(), s["label"].get<std::string>().c_str(),
                                s["saw_start"].get<bool>() ? "seen" : "not seen",
                                s["ticks"].get<unsigned long long>(), s["tick_rate_hz"].get<double>(),
-                               s["tick_period_min_ms"].get<double>(), s["tick_period_max_ms"].get<double>(),
-                               s["tick_period_std_ms"].get<double>(), s["missing_ticks"].get<unsigned long long>(),
+                               s["arrival_period_min_ms"].get<double>(), s["arrival_period_max_ms"].get<double>(),
+                               s["arrival_period_std_ms"].get<double>(), s["missing_ticks"].get<unsigned long long>(),
                                s["saw_stop"].get<bool>() ? "seen" : "not seen");
                          }
                          for (const auto& [name, st] : seen["status"].items()) {

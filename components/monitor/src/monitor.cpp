@@ -29,7 +29,7 @@ void Monitor::on_command(const msg::SyncCommand& c, std::int64_t receive_ns) {
   const auto kind = c.kind() == msg::SYNC_START  ? SyncWatch::Kind::Start
                     : c.kind() == msg::SYNC_STOP ? SyncWatch::Kind::Stop
                                                  : SyncWatch::Kind::Tick;
-  watch_.on_command(kind, c.session_id(), c.label().to_string(), c.tick(), receive_ns);
+  watch_.on_command(kind, c.session_id(), c.label().to_string(), c.tick(), c.master_stamp_ns(), receive_ns);
 }
 
 nlohmann::json Monitor::details() const {
@@ -44,10 +44,11 @@ nlohmann::json Monitor::details() const {
                         {"last_tick", s.last_tick},
                         {"missing_ticks", s.missing_ticks},
                         {"stop_tick", s.stop_tick},
-                        {"tick_rate_hz", s.tick_rate.rate_hz},
-                        {"tick_period_min_ms", s.tick_rate.min_period_s * 1e3},
-                        {"tick_period_max_ms", s.tick_rate.max_period_s * 1e3},
-                        {"tick_period_std_ms", s.tick_rate.std_period_s * 1e3}});
+                        {"tick_rate_hz", s.master_rate_hz},
+                        {"arrival_rate_hz", s.arrival.rate_hz},
+                        {"arrival_period_min_ms", s.arrival.min_period_s * 1e3},
+                        {"arrival_period_max_ms", s.arrival.max_period_s * 1e3},
+                        {"arrival_period_std_ms", s.arrival.std_period_s * 1e3}});
   }
   nlohmann::json status = nlohmann::json::object();
   for (const auto& [name, s] : status_) status[name] = s;
@@ -58,10 +59,10 @@ std::string Monitor::summary() const {
   std::string out;
   for (const auto& s : watch_.sessions()) {
     char line[256];
-    std::snprintf(line, sizeof(line), "%ssession %u '%s': %s%llu ticks at %.1f Hz (period %.1f-%.1f ms)%s%s",
+    std::snprintf(line, sizeof(line), "%ssession %u '%s': %s%llu ticks at %.1f Hz (arrival period %.1f-%.1f ms)%s%s",
                   out.empty() ? "" : "; ", s.session_id, s.label.c_str(), s.saw_start ? "START, " : "",
-                  static_cast<unsigned long long>(s.ticks), s.tick_rate.rate_hz, s.tick_rate.min_period_s * 1e3,
-                  s.tick_rate.max_period_s * 1e3, s.missing_ticks > 0 ? ", gaps" : "", s.saw_stop ? ", STOP" : "");
+                  static_cast<unsigned long long>(s.ticks), s.master_rate_hz, s.arrival.min_period_s * 1e3,
+                  s.arrival.max_period_s * 1e3, s.missing_ticks > 0 ? ", gaps" : "", s.saw_stop ? ", STOP" : "");
     out += line;
   }
   if (out.empty()) out = "no sync traffic seen";

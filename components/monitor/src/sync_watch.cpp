@@ -13,7 +13,7 @@ SyncWatch::Entry& SyncWatch::entry(std::uint32_t session_id, const std::string& 
 }
 
 void SyncWatch::on_command(Kind kind, std::uint32_t session_id, const std::string& label, std::uint64_t tick,
-                           std::int64_t receive_ns) {
+                           std::int64_t master_stamp_ns, std::int64_t receive_ns) {
   auto& e = entry(session_id, label);
   switch (kind) {
     case Kind::Start: e.obs.saw_start = true; break;
@@ -24,10 +24,14 @@ void SyncWatch::on_command(Kind kind, std::uint32_t session_id, const std::strin
     case Kind::Tick:
       if (e.obs.ticks == 0) {
         e.obs.first_tick = tick;
+        e.first_stamp_ns = master_stamp_ns;
       } else if (tick > e.obs.last_tick + 1) {
         e.obs.missing_ticks += tick - e.obs.last_tick - 1;
       }
-      e.obs.last_tick = tick > e.obs.last_tick ? tick : e.obs.last_tick;
+      if (tick > e.obs.last_tick) {
+        e.obs.last_tick = tick;
+        e.last_stamp_ns = master_stamp_ns;
+      }
       ++e.obs.ticks;
       e.rate.add(receive_ns);
       break;
@@ -38,7 +42,11 @@ std::vector<SessionObservation> SyncWatch::sessions() const {
   std::vector<SessionObservation> out;
   for (const auto& e : entries_) {
     out.push_back(e.obs);
-    out.back().tick_rate = e.rate.summary();
+    out.back().arrival = e.rate.summary();
+    const auto span = e.last_stamp_ns - e.first_stamp_ns;
+    if (e.obs.last_tick > e.obs.first_tick && span > 0) {
+      out.back().master_rate_hz = static_cast<double>(e.obs.last_tick - e.obs.first_tick) / (static_cast<double>(span) * 1e-9);
+    }
   }
   return out;
 }

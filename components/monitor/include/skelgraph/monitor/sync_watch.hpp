@@ -20,20 +20,23 @@ struct SessionObservation {
   std::uint64_t last_tick = 0;
   std::uint64_t missing_ticks = 0;  // gaps in the tick indices
   std::uint64_t stop_tick = 0;      // the last tick the master says it sent
-  runtime::RateSummary tick_rate;   // from arrival times
+  double master_rate_hz = 0.0;      // ticks per second by the master's own stamps
+  runtime::RateSummary arrival;     // at this listener (bursts when it joins late, jitter)
 };
 
 class SyncWatch {
  public:
   enum class Kind { Start, Stop, Tick };
   void on_command(Kind kind, std::uint32_t session_id, const std::string& label, std::uint64_t tick,
-                  std::int64_t receive_ns);
+                  std::int64_t master_stamp_ns, std::int64_t receive_ns);
   std::vector<SessionObservation> sessions() const;
 
  private:
   struct Entry {
     SessionObservation obs;
     runtime::RateStats rate{0};
+    std::int64_t first_stamp_ns = 0;
+    std::int64_t last_stamp_ns = 0;
   };
   Entry& entry(std::uint32_t session_id, const std::string& label);
   std::vector<Entry> entries_;
