@@ -31,8 +31,7 @@ TEST(Playback, ReplaysAGenericCsvAsALiveStream) {
     std::ofstream out(path);
     playback::write_generic_csv(rec, out);
   }
-  ComponentRegistry registry;
-  register_builtin_components(registry);
+  const auto registry = builtin_registry();
   const auto params = registry.find("playback")->info.params.resolve(
       {{"format", "generic", "test"}, {"files", std::vector<std::string>{path}, "test"}, {"rate", "2", "test"}},
       "playback");
@@ -74,8 +73,7 @@ TEST(Playback, ReplaysAGenericCsvAsALiveStream) {
 TEST(Playback, BadFileRefusesToStartNamingFileAndLine) {
   const auto path = ::testing::TempDir() + "/bad_playback.csv";
   std::ofstream(path) << "# skelgraph skeleton csv v1\nstamp_ns,sensor_id\n";
-  ComponentRegistry registry;
-  register_builtin_components(registry);
+  const auto registry = builtin_registry();
   const auto params = registry.find("playback")->info.params.resolve(
       {{"files", std::vector<std::string>{path}, "test"}}, "playback");
   Graph graph(registry, test::test_config());

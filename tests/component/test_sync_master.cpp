@@ -14,17 +14,11 @@ using namespace std::chrono_literals;
 
 namespace {
 
-ComponentRegistry builtin() {
-  ComponentRegistry r;
-  register_builtin_components(r);
-  return r;
-}
-
 Params sync_params(double period_ms, bool autostart, const std::string& label = "test") {
   RawParam p{"tick_period_ms", std::to_string(period_ms), "test"};
   RawParam a{"autostart", autostart ? "true" : "false", "test"};
   RawParam l{"label", label, "test"};
-  return builtin().find("sync_master")->info.params.resolve({p, a, l}, "sync");
+  return builtin_registry().find("sync_master")->info.params.resolve({p, a, l}, "sync");
 }
 
 struct Listener {
@@ -58,7 +52,7 @@ std::vector<msg::SyncCommand> of_kind(const std::vector<msg::SyncCommand>& v, ms
 }  // namespace
 
 TEST(SyncMaster, StartTicksAtPeriodThenStop) {
-  const auto registry = builtin();
+  const auto registry = builtin_registry();
   Listener listener;
   Graph graph(registry, test::test_config());
   graph.add("sync", "sync_master", sync_params(20.0, true, "walk"));
@@ -96,7 +90,7 @@ TEST(SyncMaster, StartTicksAtPeriodThenStop) {
 }
 
 TEST(SyncMaster, ControlRequestsStartAndStopSessions) {
-  const auto registry = builtin();
+  const auto registry = builtin_registry();
   Listener listener;
   Graph graph(registry, test::test_config());
   graph.add("sync", "sync_master", sync_params(10.0, false));
@@ -134,7 +128,7 @@ TEST(SyncMaster, ControlRequestsStartAndStopSessions) {
 }
 
 TEST(SyncMaster, LateJoinerLearnsTheRunningSession) {
-  const auto registry = builtin();
+  const auto registry = builtin_registry();
   Graph graph(registry, test::test_config());
   graph.add("sync", "sync_master", sync_params(33.0, true, "late"));
   graph.start();
@@ -157,7 +151,7 @@ TEST(SyncMaster, LateJoinerLearnsTheRunningSession) {
 }
 
 TEST(Graph, ComponentErrorsNameTheComponent) {
-  const auto registry = builtin();
+  const auto registry = builtin_registry();
   Graph graph(registry, test::test_config());
   EXPECT_THROW(graph.add("x", "no_such_kind", Params{}), std::runtime_error);
   graph.add("sync", "sync_master", sync_params(33.0, false));

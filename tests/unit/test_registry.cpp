@@ -7,8 +7,7 @@
 using namespace skelgraph::runtime;
 
 TEST(Registry, BuiltinComponentsAreRegisteredWithUsableDefaults) {
-  ComponentRegistry r;
-  register_builtin_components(r);
+  const auto r = builtin_registry();
   const auto kinds = r.kinds();
   EXPECT_NE(std::find(kinds.begin(), kinds.end(), "sync_master"), kinds.end());
   EXPECT_NE(std::find(kinds.begin(), kinds.end(), "monitor"), kinds.end());

@@ -15,8 +15,7 @@ void add_components_command(CLI::App& app, GlobalOptions&, Action& run) {
   cmd->add_flag("--json", *json, "print JSON");
   cmd->callback([json, &run] {
     run = [json] {
-      runtime::ComponentRegistry registry;
-      runtime::register_builtin_components(registry);
+      const auto registry = runtime::builtin_registry();
       nlohmann::json out = nlohmann::json::array();
       for (const auto& kind : registry.kinds()) {
         const auto& info = registry.find(kind)->info;

@@ -37,8 +37,7 @@ void add_demo_command(CLI::App& app, GlobalOptions& g, Action& run) {
   add_dds_options(*cmd, g);
   cmd->callback([o, &g, &run] {
     run = [o, &g] {
-      runtime::ComponentRegistry registry;
-      runtime::register_builtin_components(registry);
+      const auto registry = runtime::builtin_registry();
       const auto spec = runtime::parse_launch_text(kDemoGraph, "<embedded demo graph>");
       const auto components = runtime::resolve_launch(spec, registry, "");
       RunOptions ro;

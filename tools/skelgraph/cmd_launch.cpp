@@ -25,8 +25,7 @@ void add_launch_command(CLI::App& app, GlobalOptions& g, Action& run) {
   add_dds_options(*cmd, g);
   cmd->callback([o, &g, &run] {
     run = [o, &g] {
-      runtime::ComponentRegistry registry;
-      runtime::register_builtin_components(registry);
+      const auto registry = runtime::builtin_registry();
       const auto spec = runtime::parse_launch_file(o->file);
       const auto components = runtime::resolve_launch(spec, registry, o->host);
       return run_graph(registry, make_config(g, &spec), components, o->run, nullptr);

@@ -22,8 +22,7 @@ void add_run_command(CLI::App& app, GlobalOptions& g, Action& run) {
   add_dds_options(*cmd, g);
   cmd->callback([o, &g, &run] {
     run = [o, &g] {
-      runtime::ComponentRegistry registry;
-      runtime::register_builtin_components(registry);
+      const auto registry = runtime::builtin_registry();
       const auto* entry = registry.find(o->kind);
       if (entry == nullptr) {
         throw UsageError("unknown component type '" + o->kind + "' (known: " + registry.kinds_text() + ")");

@@ -34,6 +34,13 @@ namespace {
 
 constexpr std::size_t kMaxProblems = 20;
 
+Recording empty_recording(Format format, const std::string& path) {
+  Recording rec;
+  rec.format = format_name(format);
+  rec.source = path;
+  return rec;
+}
+
 // Reads every data row with the error policy applied: `parse` turns one row
 // into zero or more skeletons (appended to rec.frames) or throws DataError.
 template <class Parse>
@@ -81,9 +88,7 @@ const std::array<const char*, 20> kV1Joints = {
 const std::array<std::size_t, kJointCount> kV1Map = {3, 2, 1, 4, 5, 7, 8, 9, 11, 12, 13, 15, 16, 17, 19};
 
 Recording read_kinder_gator(const std::string& path, const ReadOptions& opt) {
-  Recording rec;
-  rec.format = format_name(Format::KinderGator);
-  rec.source = path;
+  auto rec = empty_recording(Format::KinderGator, path);
   CsvReader csv(path);
   std::vector<std::string> header;
   if (!csv.next(header)) csv.fail("empty file; expected a header starting with 'Timestamp'");
@@ -137,9 +142,7 @@ const std::array<const char*, 25> kV2Joints = {
 const std::array<std::size_t, kJointCount> kV2Map = {3, 20, 1, 4, 5, 7, 8, 9, 11, 12, 13, 15, 16, 17, 19};
 
 Recording read_kinect_v2(const std::string& path, const ReadOptions& opt) {
-  Recording rec;
-  rec.format = format_name(Format::KinectV2);
-  rec.source = path;
+  auto rec = empty_recording(Format::KinectV2, path);
   CsvReader csv(path);
   std::smatch m;
   const auto stem = fs::path(path).stem().string();
@@ -173,9 +176,7 @@ constexpr const char* kGenericMagic = "# skelgraph skeleton csv v1";
 const std::array<const char*, 8> kJointFields = {"x", "y", "z", "qw", "qx", "qy", "qz", "conf"};
 
 Recording read_generic(const std::string& path, const ReadOptions& opt) {
-  Recording rec;
-  rec.format = format_name(Format::Generic);
-  rec.source = path;
+  auto rec = empty_recording(Format::Generic, path);
   // Metadata comments come first; CsvReader sees them as one-field lines.
   CsvReader csv(path);
   std::vector<std::string> f;
