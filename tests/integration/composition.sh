@@ -26,7 +26,7 @@ check_monitor "$WORK/both.json" together
 ok "sync_master + monitor in one process"
 
 # One per process: the monitor starts first, the master joins it.
-"$SKELGRAPH" run monitor --duration 5 --json >"$WORK/mon.json" 2>"$WORK/mon.err" &
+"$SKELGRAPH" run monitor --duration 8 --json >"$WORK/mon.json" 2>"$WORK/mon.err" &
 mon=$!
 "$SKELGRAPH" run sync_master -p label=apart --duration 3 >"$WORK/sync.out" 2>"$WORK/sync.err" ||
   fail "sync_master process failed: $(cat "$WORK/sync.err")"

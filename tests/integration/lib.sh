@@ -19,6 +19,16 @@ sys.exit(0 if eval(sys.argv[2]) else 1)
 PY
 }
 
+# wait_for_match FILE PATTERN SECONDS: waits (bounded, polling) until FILE has a line matching PATTERN.
+wait_for_match() {
+  local file=$1 pattern=$2 deadline=$((SECONDS + $3))
+  while [ "$SECONDS" -lt "$deadline" ]; do
+    grep -q -- "$pattern" "$file" 2>/dev/null && return 0
+    python3 -c 'import time; time.sleep(0.05)'
+  done
+  grep -q -- "$pattern" "$file" 2>/dev/null
+}
+
 # retry N CMD...: runs CMD until it succeeds, at most N times (each try is itself bounded).
 retry() {
   local n=$1; shift

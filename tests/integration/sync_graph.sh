@@ -3,7 +3,9 @@
 # processes with `topic list/echo/hz` and driven with `sync start/stop`.
 source "$(dirname "$0")/lib.sh"
 
-"$SKELGRAPH" launch bringup/sync.yaml --duration 12 2>"$WORK/launch.err" &
+# No --duration here: the graph lives until the SIGINT at the end, so slow
+# steps on a loaded machine cannot outlast it.
+"$SKELGRAPH" launch bringup/sync.yaml 2>"$WORK/launch.err" &
 launch_pid=$!
 
 # topic list sees the graph (retry: discovery of a just-started process).
@@ -46,21 +48,22 @@ python3 -c 'import json,sys; r=json.loads(open(sys.argv[1]).readline()); s=json.
 json_check "$WORK/stop.json" 'd["kind"]=="STOP" and d["label"]=="integ" and d["tick"] >= 0'
 ok "sync start/stop from another process, confirmed by the master"
 
-wait "$launch_pid" || fail "launch exited with $? : $(cat "$WORK/launch.err")"
-grep -q '^\[stop\] sync (sync_master) OK' "$WORK/launch.err" || fail "no final status line: $(cat "$WORK/launch.err")"
-ok "launch --duration exits 0 with a status line per component"
-
-# SIGINT stops a launch without --duration cleanly (exit 0) and sends STOP.
-"$SKELGRAPH" launch bringup/sync.yaml 2>"$WORK/launch2.err" &
-pid=$!
-"$SKELGRAPH" topic echo skelgraph/sync --count 1 --timeout 10 >/dev/null || fail "second launch never ticked"
+# SIGINT stops the launch cleanly (exit 0) and the master publishes STOP first.
+"$SKELGRAPH" sync start --label final --json >"$WORK/final.json"
 "$SKELGRAPH" topic echo skelgraph/sync/session --json --timeout 15 >"$WORK/stop_seen.jsonl" &
 echo_pid=$!
-retry 50 grep -q START "$WORK/stop_seen.jsonl" 2>/dev/null || true
-kill -INT "$pid"
-wait "$pid" || fail "launch exited non-zero after SIGINT: $(cat "$WORK/launch2.err")"
-for _ in $(seq 100); do grep -q '"STOP"' "$WORK/stop_seen.jsonl" && break; python3 -c 'import time; time.sleep(0.1)'; done
+# The echo must have joined (it shows the running session's START) before the
+# launch goes away, or it could never learn of the STOP.
+wait_for_match "$WORK/stop_seen.jsonl" '"final"' 15 || fail "session echo never showed the START of 'final'"
+kill -INT "$launch_pid"
+wait "$launch_pid" || fail "launch exited non-zero after SIGINT: $(cat "$WORK/launch.err")"
+wait_for_match "$WORK/stop_seen.jsonl" '"STOP"' 10 || fail "no STOP published on SIGINT: $(cat "$WORK/stop_seen.jsonl")"
 kill "$echo_pid" 2>/dev/null || true
-grep -q '"STOP"' "$WORK/stop_seen.jsonl" || fail "no STOP published on SIGINT: $(cat "$WORK/stop_seen.jsonl")"
-ok "SIGINT: launch exits 0 and the master publishes STOP"
+grep -q '^\[stop\] sync (sync_master) OK' "$WORK/launch.err" || fail "no final status line: $(cat "$WORK/launch.err")"
+ok "SIGINT: launch exits 0 with a status line per component, and the master publishes STOP"
+
+# --duration ends a launch by itself, with exit 0.
+"$SKELGRAPH" launch bringup/sync.yaml --duration 2 2>"$WORK/launch2.err" || fail "launch --duration failed: $(cat "$WORK/launch2.err")"
+grep -q '^\[stop\] sync (sync_master) OK' "$WORK/launch2.err" || fail "no final status line: $(cat "$WORK/launch2.err")"
+ok "launch --duration exits 0"
 echo "sync_graph: all checks passed"
