@@ -30,7 +30,7 @@ expect_error "unknown component type 'fusionx'" run fusionx
 expect_error "--param tick=3: component 'sync_master' (sync_master): unknown parameter 'tick'" run sync_master -p tick=3
 expect_error "expected KEY=VALUE" run sync_master -p tick
 
-for cmd in "" "launch" "run" "topic" "topic list" "topic echo" "topic hz" "sync" "sync start" "sync stop" "demo" "components"; do
+for cmd in "" "launch" "run" "play-data" "topic" "topic list" "topic echo" "topic hz" "sync" "sync start" "sync stop" "demo" "components"; do
   # shellcheck disable=SC2086
   "$SKELGRAPH" $cmd --help >"$WORK/help" || fail "skelgraph $cmd --help failed"
   grep -q "Usage" "$WORK/help" || fail "skelgraph $cmd --help printed no usage"

@@ -7,6 +7,8 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <map>
+#include <set>
 #include <sstream>
 
 #include "skelgraph/playback/readers.hpp"
@@ -266,4 +268,142 @@ TEST(SharedData, LabanKinectV2FilesRead) {
     }
   }
   EXPECT_EQ(files, 7u);
+}
+
+// ---- KinectMultiTrack and gesture-phase ----
+
+namespace {
+std::string mt_header() {
+  const char* joints[] = {"AnkleLeft", "AnkleRight", "ElbowLeft", "ElbowRight", "FootLeft", "FootRight", "HandLeft",
+                          "HandRight", "HandTipLeft", "HandTipRight", "Head", "HipLeft", "HipRight", "KneeLeft",
+                          "KneeRight", "Neck", "ShoulderLeft", "ShoulderRight", "SpineBase", "SpineMid",
+                          "SpineShoulder", "ThumbLeft", "ThumbRight", "WristLeft", "WristRight"};
+  std::string h = "Study_Id, Kinect_Config, Scenario_Id, Tracker_Time, Person_Id, Skeleton_Id, Skeleton_Time, "
+                  "Skeleton_Init_Angle, Skeleton_Init_Dist, Kinect_Id, Kinect_Tilt_Angle, Kinect_Height";
+  for (const auto* j : joints) h += std::string(", ") + j + "_X, " + j + "_Y, " + j + "_Z";
+  return h + "\n";
+}
+// Joint j at (j, 1 + j/100, 2); joint `zero` (alphabetical index) at exactly 0, 0, 0.
+std::string mt_row(long long tracker_ms, int person, const std::string& ip, int zero = -1) {
+  std::ostringstream os;
+  os << "1, 2, 6, " << tracker_ms << ", " << person << ", 0, 156019166051, -1.19, 2.36, " << ip << ", 0, 100";
+  for (int j = 0; j < 25; ++j) {
+    if (j == zero) {
+      os << ", 0, 0, 0";
+    } else {
+      os << ", " << j << ", " << 1 + j / 100.0 << ", 2";
+    }
+  }
+  return os.str() + "\n";
+}
+}  // namespace
+
+TEST(Readers, MultiTrackTwoSensorsPeopleAndMissingJoints) {
+  const long long t0 = 63562190843413LL;  // ms since 0001-01-01
+  const auto path = write_file("mt.csv", mt_header() + mt_row(t0, 0, "138.251.207.136") +
+                                             mt_row(t0, 0, "138.251.213.82", 20) + mt_row(t0 + 34, 1, "138.251.207.136"));
+  const auto rec = read_recording(Format::MultiTrack, path);
+  ASSERT_EQ(rec.frames.size(), 3u);
+  EXPECT_EQ(rec.frames[0].sensor_id, "kinect_138_251_207_136");
+  EXPECT_EQ(rec.frames[1].sensor_id, "kinect_138_251_213_82");
+  EXPECT_EQ(rec.frames[2].person_id, 1u);
+  EXPECT_EQ(rec.frames[0].stamp_ns, (t0 - 62135596800000LL) * 1000000LL);
+  EXPECT_EQ(rec.frames[0].stamp_ns, rec.frames[1].stamp_ns);  // one tracker update, two sensors
+  // Head is alphabetical joint 10, neck SpineShoulder (20), torso SpineMid (19).
+  EXPECT_DOUBLE_EQ(rec.frames[0][JointId::Head].position.x(), 10.0);
+  EXPECT_DOUBLE_EQ(rec.frames[0][JointId::Neck].position.x(), 20.0);
+  EXPECT_DOUBLE_EQ(rec.frames[0][JointId::Torso].position.x(), 19.0);
+  EXPECT_EQ(rec.frames[1][JointId::Neck].confidence, skeleton::kLost);  // exact zeros mean missing
+  EXPECT_EQ(rec.frames[1][JointId::Head].confidence, skeleton::kTracked);
+  EXPECT_EQ(rec.metadata.at("scenarios"), "6");
+
+  std::string bad_header = mt_header();
+  bad_header.replace(bad_header.find("Head_X"), 6, "Hand_X");
+  try {
+    read_recording(Format::MultiTrack, write_file("mt_bad.csv", bad_header));
+    FAIL();
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("mt_bad.csv:1: expected column 43 to be 'Head_X', got 'Hand_X'"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(Readers, GesturePhasePackedClockBomCrlfAndLabels) {
+  const std::string header = "\xEF\xBB\xBFlhx,lhy,lhz,rhx,rhy,rhz,hx,hy,hz,sx,sy,sz,lwx,lwy,lwz,rwx,rwy,rwz,timestamp,phase\r\n";
+  const std::string pos = "1,4.5,2.2,3,4.4,2.3,2.4,0.9,2.4,2.5,3.5,2.4,1.9,4.5,2.2,3.2,4.2,2.3";
+  const auto path = write_file("gp.csv", header + pos + ",4159973,Rest\r\n" + pos + ",4200004,Prepara\xC3\xA7\xC3\xA3o\r\n");
+  const auto rec = read_recording(Format::GesturePhase, path);
+  ASSERT_EQ(rec.frames.size(), 2u);
+  EXPECT_EQ(rec.frames[1].stamp_ns - rec.frames[0].stamp_ns, 31'000'000);  // 41:59.973 -> 42:00.004
+  EXPECT_EQ(rec.frame_labels, (std::vector<std::string>{"Rest", "Preparation"}));
+  EXPECT_DOUBLE_EQ(rec.frames[0][JointId::Head].position.y(), -0.9);  // y flipped to point up
+  EXPECT_DOUBLE_EQ(rec.frames[0][JointId::LeftHand].position.x(), 1.0);
+  EXPECT_EQ(rec.frames[0][JointId::LeftElbow].confidence, skeleton::kLost);  // not in the format
+
+  EXPECT_THROW(read_recording(Format::GesturePhase, write_file("gp_bad.csv", header + pos + ",4175973,Rest\r\n")),
+               DataError);  // 41:75.973 is no clock reading
+}
+
+TEST(SharedData, MultiTrackFilesReadWithDocumentedRowsAndSensors) {
+  const auto dir = fs::path(data_dir()) / "kinect-multitrack";
+  ASSERT_TRUE(fs::is_directory(dir)) << dir << " is missing";
+  const std::map<std::string, std::size_t> rows = {
+      {"Study_12_Kinect_0_Time_4_55_27_PM.csv", 4550}, {"Study_12_Kinect_1_Time_4_58_35_PM.csv", 3452},
+      {"Study_12_Kinect_2_Time_5_01_13_PM.csv", 3434}, {"Study_12_Kinect_2_Time_5_04_00_PM.csv", 34},
+      {"Study_12_Kinect_2_Time_5_04_54_PM.csv", 52},   {"Study_14_Kinect_0_Time_5_43_18_PM.csv", 4098},
+      {"Study_14_Kinect_1_Time_5_47_14_PM.csv", 3588}, {"Study_14_Kinect_2_Time_5_50_02_PM.csv", 3392},
+      {"Study_14_Kinect_2_Time_5_52_45_PM.csv", 44},   {"Study_1_Kinect_2_Time_12_03_46_PM.csv", 3710},
+      {"Study_1_Kinect_2_Time_12_07_07_PM.csv", 724},  {"Study_22_Kinect_1_Time_2_16_21_PM.csv", 1993},
+      {"Study_24_Kinect_1_Time_2_49_46_PM.csv", 1891}};
+  std::size_t files = 0;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) {
+    if (e.path().extension() != ".csv") continue;
+    const auto name = e.path().filename().string();
+    const auto rec = read_recording(Format::MultiTrack, e.path().string());
+    ++files;
+    ASSERT_EQ(rows.count(name), 1u) << name;
+    EXPECT_EQ(rec.frames.size(), rows.at(name)) << name;
+    std::set<std::string> sensors;
+    std::size_t lost = 0;
+    for (const auto& s : rec.frames) {
+      sensors.insert(s.sensor_id);
+      for (const auto& j : s.joints) lost += j.confidence == skeleton::kLost ? 1 : 0;
+    }
+    EXPECT_EQ(sensors.size(), 2u) << name;
+    // README: only Study_22 has exact-zero joints; 18 of them fall on canonical joints
+    // (SpineShoulder 7, ShoulderLeft 4, ShoulderRight 3, HipLeft 2, HipRight 1, SpineMid 1).
+    EXPECT_EQ(lost, name.rfind("Study_22", 0) == 0 ? 18u : 0u) << name;
+    if (name == "Study_1_Kinect_2_Time_12_03_46_PM.csv") {
+      EXPECT_EQ(rec.frames.front().stamp_ns / 1'000'000'000LL, 1426593867LL);  // 2015-03-17 12:04:27 UTC
+    }
+  }
+  EXPECT_EQ(files, rows.size());
+}
+
+TEST(SharedData, GesturePhaseFilesReadWithDocumentedFramesAndLabels) {
+  const auto dir = fs::path(data_dir()) / "gesture-phase";
+  ASSERT_TRUE(fs::is_directory(dir)) << dir << " is missing";
+  const std::map<std::string, std::size_t> frames = {{"a1_raw.csv", 1747}, {"a2_raw.csv", 1264},
+                                                     {"a3_raw.csv", 1834}, {"b1_raw.csv", 1073},
+                                                     {"b3_raw.csv", 1424}, {"c1_raw.csv", 1111},
+                                                     {"c3_raw.csv", 1448}};
+  for (const auto& [name, n] : frames) {
+    const auto rec = read_recording(Format::GesturePhase, (dir / name).string());
+    EXPECT_EQ(rec.frames.size(), n) << name;
+    ASSERT_EQ(rec.frame_labels.size(), n) << name;
+    for (const auto& s : rec.frames) EXPECT_GT(s[JointId::Head].position.y(), s[JointId::Torso].position.y()) << name;
+    std::map<std::string, std::size_t> count;
+    for (const auto& l : rec.frame_labels) ++count[l];
+    if (name == "a3_raw.csv") {
+      EXPECT_EQ(count, (std::map<std::string, std::size_t>{
+                           {"Rest", 662}, {"Stroke", 535}, {"Preparation", 279}, {"Retraction", 208}, {"Hold", 150}}));
+    }
+    if (name == "b1_raw.csv") {
+      EXPECT_EQ(count["Preparation"], 412u);  // 411 + the one Portuguese spelling
+    }
+    if (name == "a1_raw.csv") {
+      EXPECT_EQ(count, (std::map<std::string, std::size_t>{{"G", 1049}, {"E", 698}}));
+    }
+  }
 }

@@ -46,6 +46,7 @@ bool wait_for_signal(std::chrono::milliseconds timeout);
 using Action = std::function<int()>;
 void add_launch_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_run_command(CLI::App& app, GlobalOptions& g, Action& run);
+void add_play_data_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_topic_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_sync_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_demo_command(CLI::App& app, GlobalOptions& g, Action& run);

@@ -104,6 +104,7 @@ int main(int argc, char** argv) {
   Action run;
   add_launch_command(app, g, run);
   add_run_command(app, g, run);
+  add_play_data_command(app, g, run);
   add_topic_command(app, g, run);
   add_sync_command(app, g, run);
   add_demo_command(app, g, run);

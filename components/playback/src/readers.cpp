@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <iomanip>
 #include <regex>
+#include <set>
 
 namespace skelgraph::playback {
 
@@ -17,14 +18,23 @@ const char* format_name(Format f) {
     case Format::Generic: return "generic";
     case Format::KinderGator: return "kinder-gator";
     case Format::KinectV2: return "kinect-v2";
+    case Format::MultiTrack: return "multitrack";
+    case Format::GesturePhase: return "gesture-phase";
   }
   return "?";
 }
 
-std::vector<std::string> format_names() { return {"generic", "kinder-gator", "kinect-v2"}; }
+constexpr Format kFormats[] = {Format::Generic, Format::KinderGator, Format::KinectV2, Format::MultiTrack,
+                               Format::GesturePhase};
+
+std::vector<std::string> format_names() {
+  std::vector<std::string> out;
+  for (auto f : kFormats) out.push_back(format_name(f));
+  return out;
+}
 
 std::optional<Format> format_from_name(std::string_view name) {
-  for (auto f : {Format::Generic, Format::KinderGator, Format::KinectV2}) {
+  for (auto f : kFormats) {
     if (name == format_name(f)) return f;
   }
   return std::nullopt;
@@ -62,6 +72,7 @@ void read_rows(CsvReader& csv, const ReadOptions& opt, Recording& rec, Parse par
     } catch (const DataError& e) {
       if (opt.on_error == ReadOptions::OnError::Stop) throw;
       rec.frames.resize(before);
+      if (rec.frame_labels.size() > before) rec.frame_labels.resize(before);
       ++rec.report.skipped;
       if (rec.report.problems.size() < kMaxProblems) rec.report.problems.push_back(e.what());
     }
@@ -170,6 +181,135 @@ Recording read_kinect_v2(const std::string& path, const ReadOptions& opt) {
   return rec;
 }
 
+// ---- KinectMultiTrack (two Kinect v2 sensors, alphabetical joint order) ----
+
+const std::array<const char*, 25> kMtJoints = {
+    "AnkleLeft", "AnkleRight", "ElbowLeft",  "ElbowRight", "FootLeft",   "FootRight",     "HandLeft",
+    "HandRight", "HandTipLeft", "HandTipRight", "Head",    "HipLeft",    "HipRight",      "KneeLeft",
+    "KneeRight", "Neck",       "ShoulderLeft", "ShoulderRight", "SpineBase", "SpineMid", "SpineShoulder",
+    "ThumbLeft", "ThumbRight", "WristLeft",  "WristRight"};
+// Same choices as for Kinect v2 above: neck = SpineShoulder, torso = SpineMid.
+const std::array<std::size_t, kJointCount> kMtMap = {10, 20, 19, 16, 2, 6, 17, 3, 7, 11, 13, 4, 12, 14, 5};
+constexpr std::size_t kMtFields = 12 + 3 * 25;
+constexpr std::int64_t kDotNetEpochToUnixMs = 62'135'596'800'000LL;  // ms from 0001-01-01 to 1970-01-01
+
+Recording read_multitrack(const std::string& path, const ReadOptions& opt) {
+  auto rec = empty_recording(Format::MultiTrack, path);
+  CsvReader csv(path);
+  std::vector<std::string> header;
+  if (!csv.next(header)) csv.fail("empty file; expected a header starting with 'Study_Id'");
+  expect_fields(csv, header, kMtFields, "12 columns, then 25 joints x X/Y/Z");
+  const std::array<const char*, 12> first = {"Study_Id", "Kinect_Config", "Scenario_Id", "Tracker_Time",
+                                             "Person_Id", "Skeleton_Id",   "Skeleton_Time", "Skeleton_Init_Angle",
+                                             "Skeleton_Init_Dist", "Kinect_Id", "Kinect_Tilt_Angle", "Kinect_Height"};
+  for (std::size_t i = 0; i < first.size(); ++i) {
+    if (header[i] != first[i]) csv.fail("expected column " + std::to_string(i + 1) + " to be '" + first[i] + "', got '" + header[i] + "'");
+  }
+  for (std::size_t j = 0; j < kMtJoints.size(); ++j) {
+    const std::string want = std::string(kMtJoints[j]) + "_X";
+    if (header[12 + 3 * j] != want) {
+      csv.fail("expected column " + std::to_string(13 + 3 * j) + " to be '" + want + "', got '" + header[12 + 3 * j] + "'");
+    }
+  }
+  // Each Kinect_Id (the sensor PC's IP address) becomes a sensor id.
+  std::map<std::string, std::string> sensors;
+  std::map<std::string, std::uint64_t> counts;
+  std::set<std::string> scenarios;
+  read_rows(csv, opt, rec, [&](const std::vector<std::string>& f) {
+    expect_fields(csv, f, kMtFields, "12 columns, then 25 joints x X/Y/Z");
+    const auto& ip = f[9];
+    if (ip.empty()) csv.fail("column 'Kinect_Id' is empty; expected the sensor's IP address");
+    auto it = sensors.find(ip);
+    if (it == sensors.end()) {
+      std::string id = opt.sensor_id.empty() ? "kinect_" + ip : opt.sensor_id + "_" + std::to_string(sensors.size());
+      std::replace(id.begin(), id.end(), '.', '_');
+      it = sensors.emplace(ip, id).first;
+    }
+    skeleton::Skeleton s;
+    s.sensor_id = it->second;
+    // Rows are already mapped into one reference skeleton's camera space (data README).
+    s.frame_id = "multitrack_reference";
+    const auto person = csv.integer(f, 4, "Person_Id");
+    if (person < 0) csv.fail("Person_Id expects a non-negative integer, got " + f[4]);
+    s.person_id = static_cast<std::uint32_t>(person);
+    s.stamp_ns = (csv.integer(f, 3, "Tracker_Time") - kDotNetEpochToUnixMs) * 1'000'000LL;
+    s.frame_number = counts[s.sensor_id + "/" + f[4]]++;
+    scenarios.insert(f[2]);
+    for (std::size_t i = 0; i < kJointCount; ++i) {
+      const auto src = kMtMap[i];
+      const std::string name = std::string(kMtJoints[src]) + "_";
+      const Eigen::Vector3d p(csv.number(f, 12 + 3 * src, name + "X"), csv.number(f, 13 + 3 * src, name + "Y"),
+                              csv.number(f, 14 + 3 * src, name + "Z"));
+      // -9999 is the logger's "missing"; exact zeros appear instead in practice.
+      const bool missing = (p.array() == -9999.0).any() || p.isZero(0.0);
+      s.joints[i].position = missing ? Eigen::Vector3d::Zero() : p;
+      s.joints[i].confidence = missing ? skeleton::kLost : skeleton::kTracked;
+    }
+    if (rec.metadata.empty()) {
+      rec.metadata["study"] = f[0];
+      rec.metadata["kinect_config"] = f[1];
+    }
+    rec.frames.push_back(std::move(s));
+  });
+  std::string list;
+  for (const auto& sc : scenarios) list += (list.empty() ? "" : ",") + sc;
+  if (!list.empty()) rec.metadata["scenarios"] = list;
+  for (const auto& [ip, id] : sensors) rec.metadata["sensor " + id] = ip;
+  return rec;
+}
+
+// ---- UCI gesture-phase (6 points, y down, phase labels) ----
+
+Recording read_gesture_phase(const std::string& path, const ReadOptions& opt) {
+  auto rec = empty_recording(Format::GesturePhase, path);
+  CsvReader csv(path);
+  std::vector<std::string> header;
+  if (!csv.next(header)) csv.fail("empty file; expected a header starting with 'lhx'");
+  const std::vector<std::string> points = {"lhx", "lhy", "lhz", "rhx", "rhy", "rhz", "hx", "hy", "hz",
+                                           "sx",  "sy",  "sz",  "lwx", "lwy", "lwz", "rwx", "rwy", "rwz"};
+  const bool timed = header.size() == 20;
+  if (header.size() != 19 && header.size() != 20) {
+    csv.fail("expected 19 columns (18 positions, phase) or 20 (18 positions, timestamp, phase), got " +
+             std::to_string(header.size()));
+  }
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (header[i] != points[i]) csv.fail("expected column " + std::to_string(i + 1) + " to be '" + points[i] + "', got '" + header[i] + "'");
+  }
+  if (timed && header[18] != "timestamp") csv.fail("expected column 19 to be 'timestamp', got '" + header[18] + "'");
+  if (header.back() != "phase") csv.fail("expected the last column to be 'phase', got '" + header.back() + "'");
+  rec.metadata["time"] = timed ? "decoded from the packed mmssfff clock" : "none in the file: 30 Hz assumed";
+  rec.metadata["units"] = "x, y scaled image coordinates (y flipped to point up), z metres";
+  const std::string sensor = opt.sensor_id.empty() ? "kinect" : opt.sensor_id;
+  // Canonical joint -> column of its x (the wrists have no canonical joint).
+  const std::vector<std::pair<JointId, std::size_t>> map = {
+      {JointId::LeftHand, 0}, {JointId::RightHand, 3}, {JointId::Head, 6}, {JointId::Torso, 9}};
+  read_rows(csv, opt, rec, [&](const std::vector<std::string>& f) {
+    expect_fields(csv, f, header.size(), timed ? "18 positions, timestamp, phase" : "18 positions, phase");
+    skeleton::Skeleton s;
+    s.sensor_id = sensor;
+    s.frame_id = sensor;
+    s.frame_number = rec.frames.size();
+    if (timed) {
+      const auto t = csv.integer(f, 18, "timestamp");
+      if (t < 0 || t % 100000 >= 60000) csv.fail("timestamp expects a packed mmssfff clock, got " + f[18]);
+      s.stamp_ns = ((t / 100000) * 60000 + t % 100000) * 1'000'000LL;
+    } else {
+      s.stamp_ns = static_cast<std::int64_t>(s.frame_number) * 33'333'333LL;
+    }
+    for (const auto& [joint, col] : map) {
+      s[joint].position = {csv.number(f, col, points[col]), -csv.number(f, col + 1, points[col + 1]),
+                           csv.number(f, col + 2, points[col + 2])};
+      s[joint].confidence = skeleton::kTracked;
+    }
+    auto phase = f.back();
+    if (phase.empty()) csv.fail("column 'phase' is empty");
+    if (phase == "Prepara\xC3\xA7\xC3\xA3o") phase = "Preparation";  // one Portuguese label in b1_raw.csv
+    rec.frame_labels.push_back(phase);
+    rec.frames.push_back(std::move(s));
+  });
+  return rec;
+}
+
 // ---- skelgraph generic CSV ----
 
 constexpr const char* kGenericMagic = "# skelgraph skeleton csv v1";
@@ -260,6 +400,8 @@ Recording read_recording(Format format, const std::string& path, const ReadOptio
     case Format::Generic: return read_generic(path, options);
     case Format::KinderGator: return read_kinder_gator(path, options);
     case Format::KinectV2: return read_kinect_v2(path, options);
+    case Format::MultiTrack: return read_multitrack(path, options);
+    case Format::GesturePhase: return read_gesture_phase(path, options);
   }
   throw std::invalid_argument("unknown format");
 }

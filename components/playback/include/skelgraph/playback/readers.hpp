@@ -20,15 +20,17 @@ enum class Format {
   Generic,      // skelgraph's own CSV (write_generic_csv writes it)
   KinderGator,  // Kinect v1, 20 joints, X/Y/Z, ms since midnight UTC
   KinectV2,     // Kinect v2 body file (laban/): ticks, 25 joints x (X, Y, Z, TrackingState)
+  MultiTrack,   // KinectMultiTrack CSV: two Kinect v2 sensors, several people, ", " separated
+  GesturePhase, // UCI gesture-phase CSV: 6 points, per-frame phase labels
 };
-const char* format_name(Format f);  // "generic", "kinder-gator", "kinect-v2"
+const char* format_name(Format f);  // "generic", "kinder-gator", "kinect-v2", "multitrack", "gesture-phase"
 std::optional<Format> format_from_name(std::string_view name);
 std::vector<std::string> format_names();
 
 struct ReadOptions {
   enum class OnError { Stop, Skip };
   OnError on_error = OnError::Stop;  // Stop: the first bad line throws DataError
-  std::string sensor_id;             // overrides the format's default sensor id
+  std::string sensor_id;             // overrides the format's default sensor id (multitrack: a prefix)
 };
 
 struct ReadReport {
@@ -43,6 +45,7 @@ struct Recording {
   std::string source;                          // the file read
   std::map<std::string, std::string> metadata;  // e.g. action, subject, gesture
   std::vector<skeleton::Skeleton> frames;       // in time order
+  std::vector<std::string> frame_labels;        // per frame when the format has them (gesture-phase), else empty
   ReadReport report;
 };
 
