@@ -162,6 +162,7 @@ TEST(Readers, GenericCsvRoundTripsEverything) {
   Recording rec;
   rec.metadata["action"] = "point";
   rec.metadata["subject"] = "s1";
+  rec.metadata["sensor_pose"] = "2.0,1.2,0.0 yaw 270";  // commas in a value survive
   for (int i = 0; i < 3; ++i) {
     skeleton::Skeleton s;
     s.sensor_id = "kinect_" + std::to_string(i % 2);

@@ -325,11 +325,13 @@ Recording read_generic(const std::string& path, const ReadOptions& opt) {
   }
   std::vector<std::string> header;
   while (csv.next(f)) {
-    if (f.size() == 1 && f[0].rfind("#", 0) == 0) {
-      const auto colon = f[0].find(':');
+    if (!f.empty() && f[0].rfind("#", 0) == 0) {
+      std::string line = f[0];  // a value may hold commas
+      for (std::size_t i = 1; i < f.size(); ++i) line += "," + f[i];
+      const auto colon = line.find(':');
       if (colon == std::string::npos) csv.fail("expected a metadata line '# key: value'");
-      auto key = f[0].substr(1, colon - 1);
-      auto value = f[0].substr(colon + 1);
+      auto key = line.substr(1, colon - 1);
+      auto value = line.substr(colon + 1);
       key.erase(0, key.find_first_not_of(' '));
       value.erase(0, value.find_first_not_of(' '));
       rec.metadata[key] = value;
@@ -408,7 +410,12 @@ Recording read_recording(Format format, const std::string& path, const ReadOptio
 
 void write_generic_csv(const Recording& rec, std::ostream& out) {
   out << kGenericMagic << "\n";
-  for (const auto& [k, v] : rec.metadata) out << "# " << k << ": " << v << "\n";
+  for (const auto& [k, v] : rec.metadata) {
+    if (k.find_first_of(":\r\n") != std::string::npos || v.find_first_of("\r\n") != std::string::npos) {
+      throw std::invalid_argument("generic CSV: metadata '" + k + "' has a line break (or a colon in its key)");
+    }
+    out << "# " << k << ": " << v << "\n";
+  }
   out << "stamp_ns,sensor_id,person_id,frame_id,frame_number";
   for (std::size_t j = 0; j < kJointCount; ++j) {
     for (const auto* suffix : kJointFields) out << "," << skeleton::joint_name(skeleton::joint_at(j)) << "_" << suffix;

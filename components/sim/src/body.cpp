@@ -35,7 +35,7 @@ struct Arm {
 };
 
 Arm arm(const BodyDimensions& b, const ArmPose& a, const Vector3d& shoulder, const Vector3d& up, const Vector3d& fwd,
-        const Vector3d& out) {
+        const Vector3d& out, double side_sign) {
   Arm r;
   r.upper_dir = (std::cos(a.elevation) * -up +
                  std::sin(a.elevation) * (std::cos(a.azimuth) * fwd + std::sin(a.azimuth) * out))
@@ -46,6 +46,8 @@ Arm arm(const BodyDimensions& b, const ArmPose& a, const Vector3d& shoulder, con
   const Vector3d target = std::abs(r.upper_dir.dot(fwd)) < 0.9 ? fwd : up;
   Vector3d axis = r.upper_dir.cross(target);
   if (axis.norm() < 1e-9) axis = out;
+  // Positive twist turns the bend towards the midline on either side.
+  axis = AngleAxisd(side_sign * a.bend_twist, r.upper_dir) * axis;
   r.fore_dir = (AngleAxisd(a.elbow_flex, axis.normalized()) * r.upper_dir).normalized();
   r.hand = r.elbow + b.forearm_hand * r.fore_dir;
   return r;
@@ -83,7 +85,7 @@ skeleton::Skeleton forward_kinematics(const BodyDimensions& b, const BodyPose& p
     const auto& ap = side == 0 ? p.left_arm : p.right_arm;
     const auto& lp = side == 0 ? p.left_leg : p.right_leg;
     const Vector3d shoulder = neck + 0.5 * b.shoulder_width * out;
-    const Arm a = arm(b, ap, shoulder, up_t, fwd_t, out);
+    const Arm a = arm(b, ap, shoulder, up_t, fwd_t, out, sign);
     // Legs hang from the pelvis in the body's (unbent) frame.
     const Vector3d hip = pelvis + 0.5 * b.hip_width * out;
     const Vector3d thigh_dir = AngleAxisd(-lp.hip_flex, left) * -world_up;

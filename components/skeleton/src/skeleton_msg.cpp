@@ -47,4 +47,39 @@ Skeleton from_msg(const msg::Skeleton& m) {
   return s;
 }
 
+msg::SensorPose to_msg(const SensorPose& p) {
+  msg::SensorPose m;
+  m.sensor_id(p.sensor_id.substr(0, 64));
+  m.frame_id(p.frame_id.substr(0, 64));
+  const Eigen::Vector3d t = p.pose.translation();
+  const Eigen::Quaterniond q(p.pose.rotation());
+  m.translation().x(t.x());
+  m.translation().y(t.y());
+  m.translation().z(t.z());
+  m.rotation().w(q.w());
+  m.rotation().x(q.x());
+  m.rotation().y(q.y());
+  m.rotation().z(q.z());
+  m.stamp_ns(p.stamp_ns);
+  m.method(p.method.substr(0, 64));
+  m.rms_residual_m(p.rms_residual_m);
+  m.max_residual_m(p.max_residual_m);
+  return m;
+}
+
+SensorPose from_msg(const msg::SensorPose& m) {
+  SensorPose p;
+  p.sensor_id = m.sensor_id().to_string();
+  p.frame_id = m.frame_id().to_string();
+  p.pose = Eigen::Isometry3d::Identity();
+  p.pose.linear() =
+      Eigen::Quaterniond(m.rotation().w(), m.rotation().x(), m.rotation().y(), m.rotation().z()).normalized().toRotationMatrix();
+  p.pose.translation() = Eigen::Vector3d(m.translation().x(), m.translation().y(), m.translation().z());
+  p.stamp_ns = m.stamp_ns();
+  p.method = m.method().to_string();
+  p.rms_residual_m = m.rms_residual_m();
+  p.max_residual_m = m.max_residual_m();
+  return p;
+}
+
 }  // namespace skelgraph::skeleton

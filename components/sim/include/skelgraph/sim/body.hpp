@@ -36,6 +36,7 @@ struct ArmPose {
   double elevation = 0.0;   // rad: 0 hanging down, pi/2 horizontal, pi straight up
   double azimuth = 0.0;     // rad around the body's vertical: 0 forward, pi/2 out to the side, pi backwards
   double elbow_flex = 0.0;  // rad: 0 straight
+  double bend_twist = 0.0;  // rad: turns the elbow's bending plane from forwards (0) towards the body's midline
 };
 
 struct LegPose {

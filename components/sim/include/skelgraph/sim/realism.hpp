@@ -1,0 +1,43 @@
+#pragma once
+// How realistic the simulator is: one sensor, one person, each thesis
+// scenario, each tracker profile, measured the way the thesis measured its
+// Kinects against Vicon (section 5.1): the detection rate of a joint group is
+// the share of sensor frames in which its joints report confidence 1; its
+// error is the mean distance to ground truth over those joints only.
+// `skelgraph sim table` prints the comparison; tests/unit/test_sim_realism.cpp
+// holds it to loose tolerances.
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace skelgraph::sim {
+
+inline constexpr std::size_t kGroupCount = 6;
+const std::array<const char*, kGroupCount>& group_names();  // Head, Neck, Torso, Shoulders, Elbows, Hands
+inline const std::vector<std::string> kThesisScenarios{"walk", "360", "hide", "box", "occ", "sit", "arms"};
+
+struct GroupFigures {
+  double detection_pct = 0.0;  // share of frames with confidence 1
+  double error_cm = 0.0;       // mean error over those
+};
+using Figures = std::array<GroupFigures, kGroupCount>;
+
+// Tables 5.1 and 5.2 of the thesis. Throws std::invalid_argument for a scenario or profile it does not have.
+Figures thesis_figures(const std::string& scenario, const std::string& profile);
+
+struct RealismOptions {
+  std::uint64_t seed = 1;
+  int repeats = 2;
+  double noise_scale = 1.0;
+};
+// Runs the simulator with its first default sensor only and measures it.
+Figures simulate_figures(const std::string& scenario, const std::string& profile, const RealismOptions& opt);
+
+// Loose agreement: detection within 20 points, error within a factor of two
+// or 6 cm of the thesis.
+bool detection_close(double sim, double thesis);
+bool error_close(double sim, double thesis);
+
+}  // namespace skelgraph::sim

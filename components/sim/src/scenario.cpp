@@ -1,0 +1,362 @@
+#include "skelgraph/sim/scenario.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "skelgraph/sim/rng.hpp"
+
+namespace skelgraph::sim {
+
+namespace {
+
+constexpr double kPi = M_PI;
+double deg(double d) { return d * kPi / 180.0; }
+double smoothstep(double u) { return u * u * (3.0 - 2.0 * u); }
+double lerp(double a, double b, double u) { return a + (b - a) * u; }
+
+ArmPose lerp(const ArmPose& a, const ArmPose& b, double u) {
+  return {lerp(a.elevation, b.elevation, u), lerp(a.azimuth, b.azimuth, u), lerp(a.elbow_flex, b.elbow_flex, u),
+          lerp(a.bend_twist, b.bend_twist, u)};
+}
+LegPose lerp(const LegPose& a, const LegPose& b, double u) {
+  return {lerp(a.hip_flex, b.hip_flex, u), lerp(a.knee_flex, b.knee_flex, u)};
+}
+
+// Facing `target` (x, z) from `from`.
+double heading_towards(const Eigen::Vector2d& from, const Eigen::Vector2d& target) {
+  const Eigen::Vector2d d = target - from;
+  return std::atan2(d.x(), d.y());
+}
+
+// Legs and arms swinging at walking pace (phase in rad).
+void gait(BodyPose& p, double phase) {
+  const double s = std::sin(phase);
+  p.left_leg = {0.30 * s, 0.15 + 0.35 * std::max(0.0, std::sin(phase + kPi / 2))};
+  p.right_leg = {-0.30 * s, 0.15 + 0.35 * std::max(0.0, std::sin(phase - kPi / 2))};
+  auto swing = [](double v) {
+    ArmPose a = arm_rest();
+    a.elevation = std::abs(v);
+    a.azimuth = v >= 0 ? 0.0 : kPi;
+    a.elbow_flex = 0.25;
+    return a;
+  };
+  p.left_arm = swing(-0.30 * s);
+  p.right_arm = swing(0.30 * s);
+}
+
+BodyPose standing(double heading = 0.0) {
+  BodyPose p;
+  p.heading = heading;
+  p.left_arm = p.right_arm = arm_rest();
+  return p;
+}
+
+// Writes the key list for one performance of a script.
+struct Builder {
+  Rng& rng;
+  std::vector<Scenario::Key>& keys;
+  BodyPose cur;
+  double t = 0.0;
+
+  double vary(double d) { return d * rng.uniform(0.9, 1.1); }
+  void hold(double d, const std::string& phase) {
+    t += vary(d);
+    keys.push_back({t, cur, phase, false});
+  }
+  void to(const BodyPose& p, double d, const std::string& phase, bool linear = false) {
+    cur = p;
+    t += vary(d);
+    keys.push_back({t, cur, phase, linear});
+  }
+};
+
+BodyPose with_arms(BodyPose p, const ArmPose& left, const ArmPose& right) {
+  p.left_arm = left;
+  p.right_arm = right;
+  return p;
+}
+
+void script_360(Builder& b) {
+  BodyPose p = with_arms(b.cur, arm_side(), arm_side());
+  b.to(p, 1.0, "t_pose");
+  b.hold(2.0, "t_pose");
+  p.heading += 2 * kPi;
+  b.to(p, 9.0, "turn_t_pose", true);
+  p = with_arms(p, arm_rest(), arm_rest());
+  b.to(p, 1.0, "arms_down");
+  p.heading += 2 * kPi;
+  b.to(p, 9.0, "turn_arms_down", true);
+  b.hold(1.0, "stand");
+}
+
+void script_hide(Builder& b) {
+  const BodyPose rest = b.cur;
+  b.hold(2.0, "stand");
+  b.to(with_arms(rest, arm_behind_back(), arm_rest()), 1.0, "hide_left");
+  b.hold(4.0, "hide_left");
+  b.to(rest, 1.0, "stand");
+  b.hold(2.0, "stand");
+  b.to(with_arms(rest, arm_rest(), arm_behind_back()), 1.0, "hide_right");
+  b.hold(4.0, "hide_right");
+  b.to(rest, 1.0, "stand");
+  b.hold(2.0, "stand");
+  b.to(with_arms(rest, arm_behind_back(), arm_behind_back()), 1.0, "hide_both");
+  b.hold(4.0, "hide_both");
+  b.to(rest, 1.0, "stand");
+}
+
+void script_box(Builder& b) {
+  const BodyPose rest = b.cur;
+  BodyPose bent = rest;
+  bent.trunk_pitch = 1.0;
+  bent.pelvis_drop = 0.22;
+  bent.left_leg = bent.right_leg = {0.7, 1.0};
+  ArmPose reach{1.0, 0.15, 0.1, 0.0};  // hanging straight down from the bent trunk, a little apart
+  bent = with_arms(bent, reach, reach);
+  BodyPose carry = rest;
+  ArmPose hold{deg(45), -0.08, 0.6, 0.0};
+  carry = with_arms(carry, hold, hold);
+  BodyPose out = rest;
+  ArmPose extend{deg(65), -0.08, 0.1, 0.0};
+  out = with_arms(out, extend, extend);
+  b.hold(2.0, "stand");
+  b.to(bent, 1.8, "bend");
+  b.hold(0.7, "grab");
+  b.to(carry, 1.8, "lift");
+  b.to(out, 1.2, "hold_out");
+  b.hold(3.0, "hold_out");
+  b.to(carry, 1.0, "lower");
+  b.to(bent, 1.8, "lower");
+  b.hold(0.5, "put_down");
+  b.to(rest, 1.8, "stand");
+  b.hold(1.0, "stand");
+}
+
+// The hiding place is behind the wall (see Scenario::props), to the person's right.
+const Eigen::Vector2d kHideSpot{-1.15, 0.0};
+
+void script_occ(Builder& b) {
+  const BodyPose rest = b.cur;
+  const Eigen::Vector2d home = rest.floor_position;
+  for (int i = 0; i < 3; ++i) {
+    b.hold(4.0, "stand");
+    BodyPose p = rest;
+    p.heading = heading_towards(home, kHideSpot);
+    b.to(p, 0.6, "turn");
+    p.floor_position = kHideSpot;
+    b.to(p, 1.6, "walk_away");
+    p.heading = rest.heading;
+    b.to(p, 0.6, "turn");
+    b.hold(2.5, "hidden");
+    p.heading = heading_towards(kHideSpot, home);
+    b.to(p, 0.6, "turn");
+    p.floor_position = home;
+    b.to(p, 1.6, "walk_back");
+    b.to(rest, 0.6, "turn");
+  }
+  b.hold(1.0, "stand");
+}
+
+void script_sit(Builder& b, double hip_height) {
+  const BodyPose rest = b.cur;
+  BodyPose seated = rest;
+  seated.pelvis_drop = hip_height - 0.50;  // hip joints 0.5 m above the floor on a 0.47 m seat
+  seated.trunk_pitch = 0.12;
+  seated.left_leg = seated.right_leg = {deg(88), deg(88)};
+  const ArmPose on_thigh{0.55, 0.1, 0.9, 0.0};
+  seated = with_arms(seated, on_thigh, on_thigh);
+  BodyPose rising = seated;  // leaning forward to get up
+  rising.trunk_pitch = 0.6;
+  for (int i = 0; i < 2; ++i) {
+    b.hold(2.0, "stand");
+    b.to(seated, 2.0, "sit_down");
+    b.hold(5.0, "sitting");
+    b.to(rising, 0.8, "stand_up");
+    b.to(rest, 1.2, "stand_up");
+  }
+  b.hold(1.0, "stand");
+}
+
+void script_arms(Builder& b) {
+  BodyPose p = b.cur;
+  // Quarter turns both ways: the thesis's Arms figures (hands 13-14 cm, 95-100 %
+  // tracked) rule out the back ever facing the sensor.
+  for (double h : {0.0, 45.0, 90.0, 45.0, 0.0, -45.0, -90.0, -45.0, 0.0}) {
+    p.heading = deg(h);
+    p = with_arms(p, arm_rest(), arm_rest());
+    b.to(p, 1.0, "rotate", true);
+    b.to(with_arms(p, arm_side(), arm_side()), 1.0, "arms_side");
+    b.hold(1.5, "arms_side");
+    b.to(p, 1.0, "arms_down");
+    b.to(with_arms(p, arm_forward(), arm_forward()), 1.0, "arms_forward");
+    b.hold(1.5, "arms_forward");
+    b.to(p, 1.0, "arms_down");
+  }
+}
+
+void script_point(Builder& b, Rng& rng) {
+  const BodyPose rest = b.cur;
+  for (int i = 0; i < 8; ++i) {
+    const bool right = rng.chance(0.5);
+    ArmPose aim;
+    aim.elevation = deg(rng.uniform(60.0, 115.0));
+    aim.azimuth = deg(rng.uniform(-20.0, 80.0));  // positive: out to that arm's side
+    aim.elbow_flex = 0.05;
+    const std::string side = right ? "right" : "left";
+    BodyPose p = rest;
+    (right ? p.right_arm : p.left_arm) = aim;
+    b.hold(rng.uniform(1.0, 2.5), "rest");
+    b.to(p, rng.uniform(0.5, 1.3), "raise:" + side);
+    b.hold(rng.uniform(0.8, 2.0), "hold:" + side);
+    b.to(rest, rng.uniform(0.5, 1.2), "retract:" + side);
+  }
+  b.hold(1.0, "rest");
+}
+
+constexpr double kWalkRadius = 0.5;
+
+}  // namespace
+
+ArmPose arm_rest() { return {0.08, kPi / 2, 0.1, 0.0}; }
+ArmPose arm_side() { return {kPi / 2, kPi / 2, 0.0, 0.0}; }
+ArmPose arm_forward() { return {kPi / 2, 0.0, 0.0, 0.0}; }
+ArmPose arm_behind_back() { return {0.55, kPi, kPi / 2, kPi / 2}; }
+
+BodyPose interpolate(const BodyPose& a, const BodyPose& b, double u) {
+  BodyPose p;
+  p.floor_position = a.floor_position + (b.floor_position - a.floor_position) * u;
+  p.heading = lerp(a.heading, b.heading, u);
+  p.pelvis_drop = lerp(a.pelvis_drop, b.pelvis_drop, u);
+  p.trunk_pitch = lerp(a.trunk_pitch, b.trunk_pitch, u);
+  p.left_arm = lerp(a.left_arm, b.left_arm, u);
+  p.right_arm = lerp(a.right_arm, b.right_arm, u);
+  p.left_leg = lerp(a.left_leg, b.left_leg, u);
+  p.right_leg = lerp(a.right_leg, b.right_leg, u);
+  return p;
+}
+
+const std::vector<std::string>& scenario_names() {
+  static const std::vector<std::string> names{"walk", "360", "hide", "box", "occ", "sit", "arms", "point"};
+  return names;
+}
+
+Scenario::Scenario(const ScenarioOptions& options) : opt_(options) {
+  if (std::find(scenario_names().begin(), scenario_names().end(), opt_.name) == scenario_names().end()) {
+    std::string all;
+    for (const auto& n : scenario_names()) all += (all.empty() ? "" : ", ") + n;
+    throw std::invalid_argument("unknown scenario '" + opt_.name + "' (expected one of: " + all + ")");
+  }
+  if (opt_.repeats < 1 || opt_.repeats > 1000) throw std::invalid_argument("scenario repeats must be 1-1000");
+  if (opt_.people < 1 || opt_.people > 8) throw std::invalid_argument("scenario people must be 1-8");
+
+  Rng rng = Rng(opt_.seed).fork(0x5ce7a210);
+  const BodyPose start = standing(heading_towards({0.0, 0.0}, opt_.facing));
+  Builder b{rng, keys_, start};
+  keys_.push_back({0.0, start, "stand", false});
+  const double hip_height = BodyDimensions::from_height(opt_.height).hip_height;
+  for (int r = 0; r < opt_.repeats; ++r) {
+    const auto& n = opt_.name;
+    if (n == "walk") {
+      const double lap = b.vary(12.0);
+      walk_period_ = walk_period_ == 0.0 ? lap : walk_period_;
+      b.t += walk_period_;
+      keys_.push_back({b.t, start, "walk", false});
+    } else if (n == "360") {
+      script_360(b);
+    } else if (n == "hide") {
+      script_hide(b);
+    } else if (n == "box") {
+      script_box(b);
+    } else if (n == "occ") {
+      script_occ(b);
+    } else if (n == "sit") {
+      script_sit(b, hip_height);
+    } else if (n == "arms") {
+      script_arms(b);
+    } else {
+      script_point(b, rng);
+    }
+  }
+  duration_ = keys_.back().t;
+}
+
+BodyPose Scenario::script_pose(double t, std::string* phase) const {
+  const auto it = std::upper_bound(keys_.begin(), keys_.end(), t, [](double v, const Key& k) { return v < k.t; });
+  if (it == keys_.begin()) {
+    *phase = keys_.front().phase;
+    return keys_.front().pose;
+  }
+  if (it == keys_.end()) {
+    *phase = keys_.back().phase;
+    return keys_.back().pose;
+  }
+  const Key& k0 = *(it - 1);
+  const Key& k1 = *it;
+  const double span = k1.t - k0.t;
+  double u = span > 0 ? (t - k0.t) / span : 1.0;
+  if (!k1.linear) u = smoothstep(u);
+  *phase = k1.phase;
+  return interpolate(k0.pose, k1.pose, u);
+}
+
+std::vector<Obstacle> Scenario::props(double t, const BodyPose& first) const {
+  std::vector<Obstacle> out;
+  if (opt_.name == "occ") {
+    // A partition 1.3 m wide and 2 m high between sensor 1 and the hiding place.
+    out.push_back({"wall", Eigen::AlignedBox3d(Eigen::Vector3d(-1.8, 0.0, 0.55), Eigen::Vector3d(-0.5, 2.0, 0.65))});
+  } else if (opt_.name == "sit") {
+    const Eigen::Vector3d c(first.floor_position.x(), 0.0, first.floor_position.y());
+    out.push_back({"chair", Eigen::AlignedBox3d(c + Eigen::Vector3d(-0.23, 0.0, -0.28), c + Eigen::Vector3d(0.23, 0.47, 0.17))});
+    out.push_back({"chair", Eigen::AlignedBox3d(c + Eigen::Vector3d(-0.23, 0.47, -0.31), c + Eigen::Vector3d(0.23, 0.95, -0.26))});
+  } else if (opt_.name == "box") {
+    std::string phase;
+    script_pose(t, &phase);
+    const Eigen::Vector3d half(0.15, 0.10, 0.12);  // a 30 x 20 x 24 cm box
+    Eigen::Vector3d centre;
+    if (phase == "lift" || phase == "hold_out" || phase == "lower") {
+      const auto s = forward_kinematics(BodyDimensions::from_height(opt_.height), first);
+      centre = 0.5 * (s[skeleton::JointId::LeftHand].position + s[skeleton::JointId::RightHand].position);
+      const Eigen::Vector3d fwd(std::sin(first.heading), 0.0, std::cos(first.heading));
+      // The hands grip its sides near the top, a little behind its middle.
+      centre += 0.04 * fwd - Eigen::Vector3d(0.0, 0.08, 0.0);
+    } else {
+      const Eigen::Vector3d fwd(std::sin(first.heading), 0.0, std::cos(first.heading));
+      centre = Eigen::Vector3d(first.floor_position.x(), half.y(), first.floor_position.y()) + 0.40 * fwd;
+    }
+    out.push_back({"box", Eigen::AlignedBox3d(centre - half, centre + half)});
+  }
+  return out;
+}
+
+Scene Scenario::at(double t) const {
+  t = std::clamp(t, 0.0, duration_);
+  Scene scene;
+  scene.t = t;
+  Actor first;
+  first.person_id = 1;
+  first.pose = script_pose(t, &first.phase);
+  if (opt_.name == "walk") {
+    const double a = 2 * kPi * t / walk_period_;
+    first.pose.floor_position = kWalkRadius * Eigen::Vector2d(std::sin(a), -std::cos(a));
+    first.pose.heading = heading_towards(first.pose.floor_position, opt_.facing);
+    gait(first.pose, 2 * kPi * 0.9 * t);
+  }
+  scene.actors.push_back(first);
+  // Others walk a wide circle through the cell, facing where they go.
+  for (int k = 1; k < opt_.people; ++k) {
+    Actor a;
+    a.person_id = static_cast<std::uint32_t>(k + 1);
+    const double angle = 2 * kPi * (t / 20.0 + static_cast<double>(k) / opt_.people) + 0.3;
+    a.pose = standing();
+    a.pose.floor_position = 1.3 * Eigen::Vector2d(std::sin(angle), std::cos(angle));
+    a.pose.heading = angle + kPi / 2;
+    gait(a.pose, 2 * kPi * 0.9 * t + k);
+    a.phase = "walk";
+    scene.actors.push_back(a);
+  }
+  scene.obstacles = props(t, first.pose);
+  return scene;
+}
+
+}  // namespace skelgraph::sim

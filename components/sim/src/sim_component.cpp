@@ -1,0 +1,158 @@
+#include "skelgraph/sim/sim_component.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "skelgraph/skeleton/skeleton_msg.hpp"
+
+namespace skelgraph::sim {
+
+namespace {
+std::int64_t mono_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+}  // namespace
+
+void add_sim_params(runtime::ParamSchema& schema) {
+  schema.add_string("scenario", "walk", "what the people do", scenario_names())
+      .add_int("repeats", 1, "times the scenario is performed in a row", 1, 1000)
+      .add_int("seed", 1, "random seed: the same seed gives the same run, bit for bit", 0)
+      .add_int("people", 1, "people in the cell (the others walk around it)", 1, 8)
+      .add_double("height", 1.75, "body height of every person, m", 0.5, 2.5)
+      .add_string("profile", "nite", "tracker model", TrackerProfile::names())
+      .add_double("noise_scale", 1.0, "scale of the tracker's random errors (0: none)", 0.0, 10.0)
+      .add_int("sensor_count", 2, "default sensors, 90 degrees apart around the cell (ignored when 'sensors' is set)", 1, 16)
+      .add_string_list("sensors", {}, "sensor poses 'id:x,y,z,yaw_deg[,pitch_deg]' (yaw 180 looks along -z)")
+      .add_double("truth_rate", 30.0, "ground-truth rate, Hz", 1.0, 1000.0)
+      .add_double("drop_probability", 0.01, "chance that a sensor frame is lost", 0.0, 0.9)
+      .add_double("jitter_ms", 2.0, "sd of sensor frame timing, ms", 0.0, 20.0);
+}
+
+SimConfig sim_config_from(const runtime::Params& params) {
+  SimConfig c;
+  c.scenario.name = params.get<std::string>("scenario");
+  c.scenario.repeats = static_cast<int>(params.get<std::int64_t>("repeats"));
+  c.scenario.seed = static_cast<std::uint64_t>(params.get<std::int64_t>("seed"));
+  c.scenario.people = static_cast<int>(params.get<std::int64_t>("people"));
+  c.scenario.height = params.get<double>("height");
+  c.profile = params.get<std::string>("profile");
+  c.noise_scale = params.get<double>("noise_scale");
+  c.truth_rate_hz = params.get<double>("truth_rate");
+  const auto specs = params.get<std::vector<std::string>>("sensors");
+  if (specs.empty()) {
+    c.sensors = default_sensors(static_cast<int>(params.get<std::int64_t>("sensor_count")));
+  } else {
+    c.sensors.clear();
+    const auto defaults = default_sensors(static_cast<int>(specs.size()));
+    for (std::size_t i = 0; i < specs.size(); ++i) c.sensors.push_back(parse_sensor(specs[i], defaults[i]));
+  }
+  for (auto& s : c.sensors) {
+    s.drop_probability = params.get<double>("drop_probability");
+    s.jitter_s = params.get<double>("jitter_ms") * 1e-3;
+  }
+  // The first person faces sensor 1.
+  c.scenario.facing = Eigen::Vector2d(c.sensors.front().position.x(), c.sensors.front().position.z());
+  return c;
+}
+
+runtime::ComponentInfo SimComponent::describe() {
+  runtime::ComponentInfo info{"sim",
+                              "Virtual work cell: ground truth on skelgraph/skeleton/truth, simulated trackers on "
+                              "skelgraph/skeleton/raw, true sensor poses on skelgraph/calibration",
+                              {}};
+  add_sim_params(info.params);
+  info.params.add_double("rate", 1.0, "speed: 1 = real time, 2 = twice as fast", 0.01, 100.0)
+      .add_bool("loop", false, "run the scenario again at the end (same seed, later clock)");
+  return info;
+}
+
+SimComponent::SimComponent(runtime::Context& ctx, const runtime::Params& params)
+    : Component(ctx),
+      config_(sim_config_from(params)),
+      rate_(params.get<double>("rate")),
+      loop_(params.get<bool>("loop")),
+      truth_pub_(ctx, runtime::topics::kSkeletonTruth),
+      raw_pub_(ctx, runtime::topics::kSkeletonRaw),
+      pose_pub_(ctx, runtime::topics::kCalibration) {
+  sim_ = std::make_unique<Simulation>(config_);  // checks the configuration before the graph starts
+}
+
+void SimComponent::publish_poses() {
+  for (const auto& s : config_.sensors) {
+    skeleton::SensorPose p;
+    p.sensor_id = s.id;
+    p.pose = s.world_from_sensor();
+    p.stamp_ns = config_.epoch_ns;
+    p.method = "ground_truth";
+    pose_pub_.publish(skeleton::to_msg(p));
+  }
+}
+
+void SimComponent::on_start() {
+  start_mono_ns_ = mono_ns();
+  config_.epoch_ns = runtime::Context::now_ns();
+  sim_ = std::make_unique<Simulation>(config_);
+  publish_poses();
+  timer_ = ctx_.executor().every(std::chrono::milliseconds(5), [this] { tick(); }, true);
+}
+
+void SimComponent::tick() {
+  const double t = static_cast<double>(mono_ns() - start_mono_ns_) * 1e-9 * rate_ - loop_offset_s_;
+  for (const auto& e : sim_->advance(t)) {
+    if (e.kind == SimEvent::Kind::Truth) {
+      truth_pub_.publish(skeleton::to_msg(e.skeleton));
+      ++truth_published_;
+    } else {
+      raw_pub_.publish(skeleton::to_msg(e.skeleton));
+      ++raw_published_;
+    }
+  }
+  if (!sim_->finished()) return;
+  ++runs_completed_;
+  if (loop_) {
+    loop_offset_s_ += sim_->duration();
+    SimConfig next = config_;
+    next.epoch_ns = config_.epoch_ns + std::llround(loop_offset_s_ * 1e9);
+    sim_ = std::make_unique<Simulation>(next);
+    return;
+  }
+  finished_ = true;
+  timer_.cancel();
+  ctx_.set_health(runtime::HealthState::Ok, "finished");
+}
+
+nlohmann::json SimComponent::details() const {
+  nlohmann::json sensors = nlohmann::json::array();
+  for (const auto& s : config_.sensors) {
+    sensors.push_back({{"id", s.id},
+                       {"position", {s.position.x(), s.position.y(), s.position.z()}},
+                       {"yaw_deg", s.yaw * 180.0 / M_PI},
+                       {"pitch_deg", s.pitch * 180.0 / M_PI},
+                       {"clock_offset_ms", s.clock_offset_s * 1e3}});
+  }
+  return {{"scenario", config_.scenario.name},
+          {"seed", config_.scenario.seed},
+          {"profile", config_.profile},
+          {"people", config_.scenario.people},
+          {"duration_s", sim_->duration()},
+          {"sensors", sensors},
+          {"truth_published", truth_published_},
+          {"raw_published", raw_published_},
+          {"runs_completed", runs_completed_},
+          {"finished", finished_}};
+}
+
+std::string SimComponent::summary() const {
+  std::ostringstream os;
+  os << config_.scenario.name << " (" << config_.profile << ", seed " << config_.scenario.seed << "): "
+     << truth_published_ << " truth and " << raw_published_ << " raw skeletons from " << config_.sensors.size()
+     << " sensor(s)";
+  if (runs_completed_ > 0) os << ", " << runs_completed_ << " run(s) completed";
+  return os.str();
+}
+
+}  // namespace skelgraph::sim
+
+SKELGRAPH_REGISTER_COMPONENT(sim, skelgraph::sim::SimComponent)

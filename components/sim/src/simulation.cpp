@@ -1,0 +1,132 @@
+#include "skelgraph/sim/simulation.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace skelgraph::sim {
+
+struct Simulation::SensorState {
+  SensorConfig config;
+  std::vector<double> times;
+  std::size_t next = 0;
+  std::uint32_t next_user_id = 1;
+  std::uint64_t frame = 0;
+  std::vector<std::unique_ptr<TrackerModel>> trackers;  // one per person
+};
+
+Simulation::Simulation(SimConfig config)
+    : cfg_(std::move(config)), scenario_(cfg_.scenario), body_(BodyDimensions::from_height(cfg_.scenario.height)) {
+  if (cfg_.sensors.empty()) throw std::invalid_argument("the simulation needs at least one sensor");
+  if (!(cfg_.truth_rate_hz > 0.0 && cfg_.truth_rate_hz <= 1000.0)) throw std::invalid_argument("truth rate must be 0-1000 Hz");
+  if (!(cfg_.noise_scale >= 0.0 && cfg_.noise_scale <= 10.0)) throw std::invalid_argument("noise scale must be 0-10");
+  const auto& profile = TrackerProfile::by_name(cfg_.profile);
+  const Rng root(cfg_.scenario.seed);
+  for (std::size_t i = 0; i < cfg_.sensors.size(); ++i) {
+    const auto& sc = cfg_.sensors[i];
+    for (std::size_t k = 0; k < i; ++k) {
+      if (cfg_.sensors[k].id == sc.id) throw std::invalid_argument("two sensors named '" + sc.id + "'");
+    }
+    if (!(sc.rate_hz > 0.0 && sc.rate_hz <= 1000.0)) throw std::invalid_argument("sensor '" + sc.id + "': bad rate");
+    auto st = std::make_unique<SensorState>();
+    st->config = sc;
+    Rng timing = root.fork(1000 + i);
+    st->times = frame_times(sc, scenario_.duration(), timing);
+    for (int p = 0; p < cfg_.scenario.people; ++p) {
+      st->trackers.push_back(std::make_unique<TrackerModel>(profile, sc, root.fork(2000 + 100 * i + p),
+                                                            cfg_.noise_scale, cfg_.scenario.height / 1.75,
+                                                            &st->next_user_id));
+    }
+    sensors_.push_back(std::move(st));
+  }
+}
+
+Simulation::~Simulation() = default;
+
+std::vector<skeleton::Skeleton> Simulation::truth_at(double t) const {
+  const Scene scene = scenario_.at(t);
+  std::vector<skeleton::Skeleton> out;
+  for (const auto& a : scene.actors) {
+    auto s = forward_kinematics(body_, a.pose);
+    s.sensor_id = "truth";
+    s.person_id = a.person_id;
+    s.stamp_ns = cfg_.epoch_ns + std::llround(t * 1e9);
+    out.push_back(std::move(s));
+  }
+  return out;
+}
+
+std::size_t Simulation::frame_count(std::size_t sensor) const { return sensors_.at(sensor)->times.size(); }
+
+bool Simulation::finished() const {
+  const double next_truth = static_cast<double>(truth_frame_) / cfg_.truth_rate_hz;
+  if (next_truth < scenario_.duration()) return false;
+  for (const auto& s : sensors_) {
+    if (s->next < s->times.size()) return false;
+  }
+  return true;
+}
+
+void Simulation::emit_truth(double t, std::vector<SimEvent>& out) {
+  for (auto& s : truth_at(t)) {
+    SimEvent e;
+    e.kind = SimEvent::Kind::Truth;
+    e.t = t;
+    e.actor = s.person_id;
+    s.frame_number = truth_frame_;
+    e.skeleton = std::move(s);
+    out.push_back(std::move(e));
+  }
+}
+
+void Simulation::emit_raw(std::size_t i, double t, std::vector<SimEvent>& out) {
+  auto& st = *sensors_[i];
+  const Scene scene = scenario_.at(t);
+  std::vector<skeleton::Skeleton> truths;
+  for (const auto& a : scene.actors) truths.push_back(forward_kinematics(body_, a.pose));
+  ++st.frame;
+  for (std::size_t p = 0; p < st.trackers.size(); ++p) {
+    auto s = st.trackers[p]->observe(t, scene, p, truths);
+    if (!s) continue;
+    SimEvent e;
+    e.kind = SimEvent::Kind::Raw;
+    e.t = t;
+    e.sensor = i;
+    e.actor = scene.actors[p].person_id;
+    s->stamp_ns = sensor_stamp_ns(st.config, t, cfg_.epoch_ns);
+    s->frame_number = st.frame;
+    e.skeleton = std::move(*s);
+    out.push_back(std::move(e));
+  }
+}
+
+std::vector<SimEvent> Simulation::advance(double t) {
+  std::vector<SimEvent> out;
+  for (;;) {
+    // The earliest pending event; truth first on a tie.
+    double best = t;
+    int which = -2;  // -1 truth, >= 0 a sensor
+    const double next_truth = static_cast<double>(truth_frame_) / cfg_.truth_rate_hz;
+    if (next_truth < scenario_.duration() && next_truth < best) {
+      best = next_truth;
+      which = -1;
+    }
+    for (std::size_t i = 0; i < sensors_.size(); ++i) {
+      const auto& s = *sensors_[i];
+      if (s.next < s.times.size() && s.times[s.next] < best) {
+        best = s.times[s.next];
+        which = static_cast<int>(i);
+      }
+    }
+    if (which == -2) break;
+    if (which == -1) {
+      emit_truth(best, out);
+      ++truth_frame_;
+    } else {
+      emit_raw(static_cast<std::size_t>(which), best, out);
+      ++sensors_[static_cast<std::size_t>(which)]->next;
+    }
+  }
+  return out;
+}
+
+}  // namespace skelgraph::sim

@@ -1,0 +1,191 @@
+// skelgraph sim table: the simulator against the thesis's Tables 5.1/5.2
+// (one sensor, each scenario and tracker profile); skelgraph sim export: a
+// whole run written to generic CSV files. No DDS.
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+#include <nlohmann/json.hpp>
+
+#include "cli.hpp"
+#include "skelgraph/playback/readers.hpp"
+#include "skelgraph/sim/realism.hpp"
+#include "skelgraph/sim/sim_component.hpp"
+#include "skelgraph/sim/simulation.hpp"
+#include "skelgraph/sim/tracker.hpp"
+
+namespace skelgraph::cli {
+
+namespace {
+
+int table(const sim::RealismOptions& opt, bool json, bool check) {
+  nlohmann::json out = nlohmann::json::array();
+  int misses = 0, cells = 0;
+  if (!json) {
+    std::printf("Detection %% (sim / thesis) and mean error of tracked joints, cm (sim / thesis); '*' = outside tolerance\n");
+    std::printf("seed %llu, %d repeat(s) of each scenario, one sensor 2 m away\n",
+                static_cast<unsigned long long>(opt.seed), opt.repeats);
+  }
+  for (const auto& profile : sim::TrackerProfile::names()) {
+    if (!json) {
+      std::printf("\n%-6s %-10s", profile.c_str(), "group");
+      for (const auto& s : sim::kThesisScenarios) std::printf(" | %-21s", s.c_str());
+      std::printf("\n");
+    }
+    std::vector<sim::Figures> sims, refs;
+    for (const auto& s : sim::kThesisScenarios) {
+      std::fprintf(stderr, "\rsimulating %s %s...      ", profile.c_str(), s.c_str());
+      sims.push_back(sim::simulate_figures(s, profile, opt));
+      refs.push_back(sim::thesis_figures(s, profile));
+    }
+    std::fprintf(stderr, "\r%40s\r", "");
+    for (std::size_t g = 0; g < sim::kGroupCount; ++g) {
+      if (!json) std::printf("%-6s %-10s", "", sim::group_names()[g]);
+      for (std::size_t k = 0; k < sims.size(); ++k) {
+        const auto& a = sims[k][g];
+        const auto& b = refs[k][g];
+        const bool det_ok = sim::detection_close(a.detection_pct, b.detection_pct);
+        const bool err_ok = std::isfinite(a.error_cm) && sim::error_close(a.error_cm, b.error_cm);
+        misses += (det_ok ? 0 : 1) + (err_ok ? 0 : 1);
+        cells += 2;
+        if (json) {
+          out.push_back({{"profile", profile}, {"scenario", sim::kThesisScenarios[k]}, {"group", sim::group_names()[g]},
+                         {"sim_detection_pct", a.detection_pct}, {"thesis_detection_pct", b.detection_pct},
+                         {"sim_error_cm", std::isfinite(a.error_cm) ? nlohmann::json(a.error_cm) : nlohmann::json()},
+                         {"thesis_error_cm", b.error_cm}, {"detection_close", det_ok}, {"error_close", err_ok}});
+        } else {
+          std::printf(" | %3.0f/%3.0f%c %5.1f/%5.1f%c", a.detection_pct, b.detection_pct, det_ok ? ' ' : '*', a.error_cm,
+                      b.error_cm, err_ok ? ' ' : '*');
+        }
+      }
+      if (!json) std::printf("\n");
+    }
+  }
+  if (json) {
+    std::printf("%s\n", nlohmann::json{{"seed", opt.seed}, {"repeats", opt.repeats}, {"cells", cells},
+                                       {"outside_tolerance", misses}, {"rows", out}}
+                            .dump(2)
+                            .c_str());
+  } else {
+    std::printf("\n%d of %d figures outside tolerance (detection: 20 points; error: factor 2 or 6 cm)\n", misses, cells);
+  }
+  return check && misses > 0 ? 1 : 0;
+}
+
+void write_file(const std::filesystem::path& path, const playback::Recording& rec) {
+  std::ofstream out(path);
+  if (!out) throw std::runtime_error("cannot write " + path.string());
+  playback::write_generic_csv(rec, out);
+  if (!out.flush()) throw std::runtime_error("error writing " + path.string());
+}
+
+// Runs the simulation offline and writes truth.csv, raw_<sensor>.csv and phases.csv.
+int export_run(const std::vector<std::string>& assignments, const std::string& dir, bool json) {
+  runtime::ParamSchema schema;
+  sim::add_sim_params(schema);
+  sim::SimConfig cfg;
+  try {
+    std::vector<runtime::RawParam> raw;
+    for (const auto& p : assignments) raw.push_back(runtime::parse_param_assignment(p, "--param " + p));
+    cfg = sim::sim_config_from(schema.resolve(raw, "sim export"));
+    sim::Simulation probe(cfg);  // checks the configuration
+  } catch (const runtime::ParamError& e) {
+    throw UsageError(e.what());
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  sim::Simulation sim(cfg);
+  std::map<std::string, std::string> meta{{"source", "skelgraph sim"},
+                                          {"scenario", cfg.scenario.name},
+                                          {"seed", std::to_string(cfg.scenario.seed)},
+                                          {"repeats", std::to_string(cfg.scenario.repeats)},
+                                          {"people", std::to_string(cfg.scenario.people)},
+                                          {"profile", cfg.profile}};
+  playback::Recording truth;
+  truth.format = "generic";
+  truth.metadata = meta;
+  truth.metadata["frame"] = "world";
+  std::vector<playback::Recording> raw(cfg.sensors.size());
+  for (std::size_t i = 0; i < raw.size(); ++i) {
+    const auto& s = cfg.sensors[i];
+    raw[i].format = "generic";
+    raw[i].metadata = meta;
+    const Eigen::Vector3d p = s.position;
+    raw[i].metadata["sensor_pose"] = std::to_string(p.x()) + "," + std::to_string(p.y()) + "," + std::to_string(p.z()) +
+                                     " yaw " + std::to_string(s.yaw * 180.0 / M_PI) + " pitch " +
+                                     std::to_string(s.pitch * 180.0 / M_PI);
+    raw[i].metadata["clock_offset_ms"] = std::to_string(s.clock_offset_s * 1e3);
+  }
+  std::filesystem::create_directories(dir);
+  std::ofstream phases(std::filesystem::path(dir) / "phases.csv");
+  phases << "stamp_ns,person_id,phase\n";
+  const double step = 5.0;  // s of simulated time per batch (progress)
+  for (double t = step;; t += step) {
+    for (auto& e : sim.advance(t)) {
+      if (e.kind == sim::SimEvent::Kind::Truth) {
+        for (const auto& a : sim.scenario().at(e.t).actors) {
+          if (a.person_id == e.actor) phases << e.skeleton.stamp_ns << "," << a.person_id << "," << a.phase << "\n";
+        }
+        truth.frames.push_back(std::move(e.skeleton));
+      } else {
+        raw[e.sensor].frames.push_back(std::move(e.skeleton));
+      }
+    }
+    if (!json) std::fprintf(stderr, "\rsimulated %.0f of %.0f s", std::min(t, sim.duration()), sim.duration());
+    if (sim.finished()) break;
+  }
+  if (!json) std::fprintf(stderr, "\n");
+  nlohmann::json files = nlohmann::json::object();
+  write_file(std::filesystem::path(dir) / "truth.csv", truth);
+  files["truth.csv"] = truth.frames.size();
+  for (std::size_t i = 0; i < raw.size(); ++i) {
+    const auto name = "raw_" + cfg.sensors[i].id + ".csv";
+    write_file(std::filesystem::path(dir) / name, raw[i]);
+    files[name] = raw[i].frames.size();
+  }
+  if (!phases.flush()) throw std::runtime_error("error writing phases.csv");
+  files["phases.csv"] = truth.frames.size();
+  if (json) {
+    std::printf("%s\n", nlohmann::json{{"directory", dir}, {"duration_s", sim.duration()}, {"rows", files}}.dump(2).c_str());
+  } else {
+    for (const auto& [name, rows] : files.items()) std::printf("%s/%s: %s rows\n", dir.c_str(), name.c_str(), rows.dump().c_str());
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_sim_command(CLI::App& app, GlobalOptions&, Action& run) {
+  auto* cmd = app.add_subcommand("sim", "Offline tools of the work-cell simulator");
+  cmd->require_subcommand(1);
+  struct Opts {
+    sim::RealismOptions realism;
+    bool json = false;
+    bool check = false;
+  };
+  auto o = std::make_shared<Opts>();
+  auto* t = cmd->add_subcommand("table", "Compare the simulator with the thesis's Tables 5.1/5.2 (one sensor)");
+  t->add_option("--seed", o->realism.seed, "random seed");
+  t->add_option("--repeats", o->realism.repeats, "repeats of each scenario")->check(CLI::Range(1, 100));
+  t->add_option("--noise-scale", o->realism.noise_scale, "scale of the tracker's noise")->check(kNonNegative);
+  t->add_flag("--json", o->json, "machine-readable output");
+  t->add_flag("--check", o->check, "exit 1 if any figure is outside tolerance");
+  t->callback([o, &run] { run = [o] { return table(o->realism, o->json, o->check); }; });
+
+  struct ExportOpts {
+    std::string dir;
+    std::vector<std::string> params;
+    bool json = false;
+  };
+  auto e = std::make_shared<ExportOpts>();
+  auto* x = cmd->add_subcommand("export", "Run a simulation offline and write it as generic CSV (truth, each sensor, phases)");
+  x->add_option("directory", e->dir, "output directory (created)")->required();
+  x->add_option("-p,--param", e->params, "sim parameter as KEY=VALUE, as in `skelgraph components` (repeatable)");
+  x->add_flag("--json", e->json, "machine-readable summary");
+  x->callback([e, &run] { run = [e] { return export_run(e->params, e->dir, e->json); }; });
+}
+
+}  // namespace skelgraph::cli
