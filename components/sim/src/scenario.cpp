@@ -106,13 +106,19 @@ void script_hide(Builder& b) {
   b.to(rest, 1.0, "stand");
 }
 
-void script_box(Builder& b) {
+// How far the hips come down when the knees bend with the feet on the floor.
+double crouch_drop(const BodyDimensions& d, const LegPose& leg) {
+  const double standing = d.thigh + d.shank;
+  return standing - (d.thigh * std::cos(leg.hip_flex) + d.shank * std::cos(leg.knee_flex - leg.hip_flex));
+}
+
+void script_box(Builder& b, const BodyDimensions& d) {
   const BodyPose rest = b.cur;
   BodyPose bent = rest;
-  bent.trunk_pitch = 1.0;
-  bent.pelvis_drop = 0.22;
-  bent.left_leg = bent.right_leg = {0.7, 1.0};
-  ArmPose reach{1.0, 0.15, 0.1, 0.0};  // hanging straight down from the bent trunk, a little apart
+  bent.trunk_pitch = 1.2;
+  bent.left_leg = bent.right_leg = {1.0, 1.6};
+  bent.pelvis_drop = crouch_drop(d, bent.left_leg);
+  ArmPose reach{1.2, 0.15, 0.1, 0.0};  // hanging straight down from the bent trunk, a little apart
   bent = with_arms(bent, reach, reach);
   BodyPose carry = rest;
   ArmPose hold{deg(45), -0.08, 0.6, 0.0};
@@ -258,7 +264,7 @@ Scenario::Scenario(const ScenarioOptions& options) : opt_(options) {
   for (int r = 0; r < opt_.repeats; ++r) {
     const auto& n = opt_.name;
     if (n == "walk") {
-      const double lap = b.vary(12.0);
+      const double lap = b.vary(20.0);
       walk_period_ = walk_period_ == 0.0 ? lap : walk_period_;
       b.t += walk_period_;
       keys_.push_back({b.t, start, "walk", false});
@@ -267,7 +273,7 @@ Scenario::Scenario(const ScenarioOptions& options) : opt_(options) {
     } else if (n == "hide") {
       script_hide(b);
     } else if (n == "box") {
-      script_box(b);
+      script_box(b, BodyDimensions::from_height(opt_.height));
     } else if (n == "occ") {
       script_occ(b);
     } else if (n == "sit") {
@@ -297,7 +303,13 @@ BodyPose Scenario::script_pose(double t, std::string* phase) const {
   double u = span > 0 ? (t - k0.t) / span : 1.0;
   if (!k1.linear) u = smoothstep(u);
   *phase = k1.phase;
-  return interpolate(k0.pose, k1.pose, u);
+  BodyPose p = interpolate(k0.pose, k1.pose, u);
+  // Keyframes keep the feet on the floor; blends between them must too.
+  const auto d = BodyDimensions::from_height(opt_.height);
+  for (const auto* leg : {&p.left_leg, &p.right_leg}) {
+    p.pelvis_drop = std::min(p.pelvis_drop, crouch_drop(d, *leg));
+  }
+  return p;
 }
 
 std::vector<Obstacle> Scenario::props(double t, const BodyPose& first) const {

@@ -120,7 +120,7 @@ TrackerProfile make_mssdk() {
   p.back_limbs_inferred = 0.6;
   p.head_doubt = 0.0;
   p.head_doubt_unusual = 0.0;
-  p.elbow_doubt_bent = 0.1;
+  p.elbow_doubt_bent = 0.0;
   p.elbow_doubt_sitting = 0.4;
   p.flip_delay_s = 0.5;
   p.unflip_delay_s = 0.8;
@@ -377,7 +377,7 @@ std::optional<skeleton::Skeleton> TrackerModel::observe(double t, const Scene& s
   const Vector3d up = Vector3d::UnitY();
   const Vector3d left = up.cross(fwd);
   const double bent = std::clamp(pose.trunk_pitch / 0.8, 0.0, 1.0);
-  const double sitting = std::clamp(pose.pelvis_drop / 0.3, 0.0, 1.0);
+  const double sitting = std::clamp(pose.pelvis_drop / 0.3, 0.0, 1.0) * (1.0 - bent);  // hips down, trunk up
   const double unusual = std::min(1.0, bent + sitting);
 
   // A prop hiding part of the body merges with it in the depth image and

@@ -1,0 +1,395 @@
+// The simulator's core: scenarios, sensors, tracker model, determinism.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+
+#include "skelgraph/sim/rng.hpp"
+#include "skelgraph/sim/scenario.hpp"
+#include "skelgraph/sim/sensor.hpp"
+#include "skelgraph/sim/simulation.hpp"
+#include "skelgraph/sim/tracker.hpp"
+
+using namespace skelgraph;
+using skeleton::JointId;
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+double bone(const skeleton::Skeleton& s, JointId a, JointId b) { return (s[a].position - s[b].position).norm(); }
+}  // namespace
+
+TEST(SimRng, SameSeedSameNumbersAndForksAreIndependent) {
+  sim::Rng a(42), b(42), c(43);
+  for (int i = 0; i < 100; ++i) {
+    const auto x = a.next();
+    EXPECT_EQ(x, b.next());
+    EXPECT_NE(x, c.next());
+  }
+  sim::Rng f1 = sim::Rng(7).fork(1), f2 = sim::Rng(7).fork(2);
+  EXPECT_NE(f1.next(), f2.next());
+  double sum = 0, sq = 0;
+  const int n = 200000;
+  for (int i = 0; i < n; ++i) {
+    const double v = a.normal();
+    sum += v;
+    sq += v * v;
+  }
+  EXPECT_NEAR(sum / n, 0.0, 0.01);
+  EXPECT_NEAR(sq / n, 1.0, 0.01);
+}
+
+TEST(SimScenario, EveryScenarioRunsWithConstantBonesAndIsSeeded) {
+  const auto body = sim::BodyDimensions::from_height(1.75);
+  for (const auto& name : sim::scenario_names()) {
+    SCOPED_TRACE(name);
+    sim::ScenarioOptions o;
+    o.name = name;
+    o.seed = 5;
+    const sim::Scenario sc(o);
+    EXPECT_GT(sc.duration(), 15.0);
+    EXPECT_LT(sc.duration(), 90.0);
+    std::set<std::string> phases;
+    for (double t = 0; t <= sc.duration(); t += 0.1) {
+      const auto scene = sc.at(t);
+      ASSERT_EQ(scene.actors.size(), 1u);
+      phases.insert(scene.actors[0].phase);
+      const auto s = sim::forward_kinematics(body, scene.actors[0].pose);
+      ASSERT_NEAR(bone(s, JointId::LeftShoulder, JointId::LeftElbow), body.upper_arm, 1e-9);
+      ASSERT_NEAR(bone(s, JointId::RightElbow, JointId::RightHand), body.forearm_hand, 1e-9);
+      ASSERT_NEAR(bone(s, JointId::LeftKnee, JointId::LeftFoot), body.shank, 1e-9);
+      for (const auto& j : s.joints) ASSERT_GT(j.position.y(), 0.0);  // nobody goes through the floor
+    }
+    EXPECT_GE(phases.size(), name == "walk" ? 1u : 3u);
+    // Same seed: same motion; another seed: other timings.
+    o.seed = 5;
+    const sim::Scenario same(o);
+    o.seed = 6;
+    const sim::Scenario other(o);
+    EXPECT_EQ(same.duration(), sc.duration());
+    EXPECT_NE(other.duration(), sc.duration());
+  }
+  EXPECT_THROW(sim::Scenario(sim::ScenarioOptions{"dance"}), std::invalid_argument);
+}
+
+TEST(SimScenario, ScriptsDoWhatTheirNamesSay) {
+  const auto body = sim::BodyDimensions::from_height(1.75);
+  auto run = [](const std::string& name) {
+    sim::ScenarioOptions o;
+    o.name = name;
+    return sim::Scenario(o);
+  };
+  // 360: two full turns, the first in T-pose.
+  const auto turn = run("360");
+  double min_h = 1e9, max_h = -1e9;
+  bool t_pose_seen = false;
+  for (double t = 0; t <= turn.duration(); t += 0.05) {
+    const auto a = turn.at(t).actors[0];
+    min_h = std::min(min_h, a.pose.heading);
+    max_h = std::max(max_h, a.pose.heading);
+    if (a.phase == "turn_t_pose") {
+      t_pose_seen = true;
+      EXPECT_NEAR(a.pose.left_arm.elevation, kPi / 2, 1e-9);
+    }
+  }
+  EXPECT_TRUE(t_pose_seen);
+  EXPECT_NEAR(max_h - min_h, 4 * kPi, 1e-9);
+
+  // hide: the hidden hand is behind the back, near the spine.
+  const auto hide = run("hide");
+  bool checked = false;
+  for (double t = 0; t <= hide.duration(); t += 0.1) {
+    const auto a = hide.at(t).actors[0];
+    if (a.phase != "hide_left") continue;
+    const auto s = sim::forward_kinematics(body, a.pose);
+    const Eigen::Vector3d fwd(std::sin(a.pose.heading), 0, std::cos(a.pose.heading));
+    const Eigen::Vector3d rel = s[JointId::LeftHand].position - s[JointId::Torso].position;
+    if (std::abs(a.pose.left_arm.elbow_flex - kPi / 2) < 1e-6) {
+      EXPECT_LT(rel.dot(fwd), -0.1);
+      EXPECT_LT(std::abs(rel.x()), 0.12);
+      checked = true;
+    }
+  }
+  EXPECT_TRUE(checked);
+
+  // occ: there is a wall, and the person goes behind it.
+  const auto occ = run("occ");
+  ASSERT_EQ(occ.at(0).obstacles.size(), 1u);
+  EXPECT_EQ(occ.at(0).obstacles[0].kind, "wall");
+
+  // box: the box starts on the floor and is held out at chest height.
+  const auto box = run("box");
+  double highest = 0;
+  for (double t = 0; t <= box.duration(); t += 0.1) highest = std::max(highest, box.at(t).obstacles[0].box.center().y());
+  EXPECT_LT(box.at(0).obstacles[0].box.center().y(), 0.2);
+  EXPECT_GT(highest, 1.0);
+
+  // sit: the hips come down to seat height.
+  const auto sit = run("sit");
+  double lowest_hip = 10;
+  for (double t = 0; t <= sit.duration(); t += 0.1) {
+    lowest_hip = std::min(lowest_hip, sim::forward_kinematics(body, sit.at(t).actors[0].pose)[JointId::LeftHip].position.y());
+  }
+  EXPECT_NEAR(lowest_hip, 0.50, 0.02);
+
+  // point: both arms point, each gesture raise -> hold -> retract.
+  const auto point = run("point");
+  std::set<std::string> phases;
+  for (double t = 0; t <= point.duration(); t += 0.05) phases.insert(point.at(t).actors[0].phase);
+  EXPECT_TRUE(phases.count("raise:left") && phases.count("hold:left") && phases.count("retract:left"));
+  EXPECT_TRUE(phases.count("raise:right") && phases.count("hold:right") && phases.count("retract:right"));
+
+  // Two people: the second walks a wide circle.
+  sim::ScenarioOptions two;
+  two.name = "point";
+  two.people = 2;
+  const sim::Scenario both(two);
+  const auto scene = both.at(3.0);
+  ASSERT_EQ(scene.actors.size(), 2u);
+  EXPECT_EQ(scene.actors[1].person_id, 2u);
+  EXPECT_NEAR(scene.actors[1].pose.floor_position.norm(), 1.3, 1e-9);
+}
+
+TEST(SimSensor, DefaultSensorsLookAtTheCellFrom90DegreesApart) {
+  const auto s = sim::default_sensors(2);
+  ASSERT_EQ(s.size(), 2u);
+  const Eigen::Vector3d centre(0, 1.2, 0);
+  for (const auto& c : s) {
+    const sim::SensorView v(c);
+    const Eigen::Vector3d p = v.to_sensor(centre);
+    EXPECT_NEAR(p.x(), 0.0, 1e-9);
+    EXPECT_NEAR(p.z(), 2.0, 1e-9);  // straight ahead, 2 m
+    EXPECT_TRUE(v.in_view(centre));
+  }
+  const Eigen::Vector3d d0 = s[0].world_from_sensor().linear().col(2), d1 = s[1].world_from_sensor().linear().col(2);
+  EXPECT_NEAR(d0.dot(d1), 0.0, 1e-9);
+  EXPECT_NE(s[0].clock_offset_s, s[1].clock_offset_s);
+  // Sensor x is the sensor's left: for sensor1 (looking along -z) that is world -x.
+  EXPECT_NEAR(sim::SensorView(s[0]).to_sensor(Eigen::Vector3d(-1, 1.2, 0)).x(), 1.0, 1e-9);
+}
+
+TEST(SimSensor, FieldOfViewRangeAndOcclusion) {
+  const sim::SensorView v(sim::default_sensors(1)[0]);  // at (0, 1.2, 2) looking along -z
+  EXPECT_TRUE(v.in_view({0, 1.2, 0}));
+  EXPECT_FALSE(v.in_view({0, 1.2, 1.5}));   // 0.5 m: too close
+  EXPECT_FALSE(v.in_view({0, 1.2, -2.5}));  // 4.5 m: too far
+  const double half_h = 57.0 / 2 * kPi / 180;
+  EXPECT_TRUE(v.in_view({2.0 * std::tan(half_h) - 0.01, 1.2, 0}));
+  EXPECT_FALSE(v.in_view({2.0 * std::tan(half_h) + 0.01, 1.2, 0}));
+  const double half_v = 43.0 / 2 * kPi / 180;
+  EXPECT_FALSE(v.in_view({0, 1.2 + 2.0 * std::tan(half_v) + 0.01, 0}));
+
+  const std::vector<sim::Obstacle> wall{{"wall", Eigen::AlignedBox3d(Eigen::Vector3d(-0.5, 0, 0.9), Eigen::Vector3d(0.5, 2, 1.0))}};
+  double depth = 0;
+  EXPECT_TRUE(v.blocked({0, 1.2, 0}, wall, &depth));
+  EXPECT_NEAR(depth, 1.0, 1e-9);
+  EXPECT_FALSE(v.blocked({1.5, 1.2, 0}, wall));
+  EXPECT_FALSE(v.blocked({0, 1.2, 1.2}, wall));  // in front of the wall
+}
+
+TEST(SimSensor, ParsesPosesAndRejectsBadOnes) {
+  const auto c = sim::parse_sensor("left:1,1.5,-2,90,10");
+  EXPECT_EQ(c.id, "left");
+  EXPECT_EQ(c.position, Eigen::Vector3d(1, 1.5, -2));
+  EXPECT_NEAR(c.yaw, kPi / 2, 1e-12);
+  EXPECT_NEAR(c.pitch, 10 * kPi / 180, 1e-12);
+  for (const char* bad : {"1,2,3,4", "x:1,2,3", "x:1,2,three,4", "x:1,2,3,4,5,6", "x:1,2,3,nan"}) {
+    EXPECT_THROW(sim::parse_sensor(bad), std::invalid_argument) << bad;
+  }
+  try {
+    sim::parse_sensor("x:1,2,three,4");
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("'three' is not a number"), std::string::npos) << e.what();
+  }
+}
+
+TEST(SimSensor, FramesAt30HzWithJitterAndDrops) {
+  sim::SensorConfig c;
+  c.drop_probability = 0.02;
+  sim::Rng rng(3);
+  const auto t = sim::frame_times(c, 100.0, rng);
+  EXPECT_NEAR(static_cast<double>(t.size()), 3000 * 0.98, 60);
+  double worst = 0;
+  for (std::size_t i = 1; i < t.size(); ++i) {
+    ASSERT_GT(t[i], t[i - 1]);
+    worst = std::max(worst, t[i] - t[i - 1]);
+  }
+  EXPECT_GT(worst, 2.0 / 30.0 - 0.01);  // a drop leaves a gap
+  c.clock_offset_s = 0.012;
+  EXPECT_EQ(sim::sensor_stamp_ns(c, 1.0, 1'000'000'000), 2'012'000'000);
+}
+
+namespace {
+sim::SimConfig one_sensor(const std::string& scenario, const std::string& profile, std::uint64_t seed = 1) {
+  sim::SimConfig cfg;
+  cfg.scenario.name = scenario;
+  cfg.scenario.seed = seed;
+  cfg.sensors = {sim::default_sensors(1)[0]};
+  cfg.profile = profile;
+  return cfg;
+}
+}  // namespace
+
+TEST(SimTracker, FacingTheSensorItTracksEverythingAccurately) {
+  auto cfg = one_sensor("walk", "mssdk");
+  cfg.noise_scale = 0.0;
+  sim::Simulation sim(cfg);
+  const auto world_from_sensor = cfg.sensors[0].world_from_sensor();
+  int frames = 0;
+  for (const auto& e : sim.advance(sim.duration())) {
+    if (e.kind != sim::SimEvent::Kind::Raw || e.t < 1.0) continue;
+    ++frames;
+    EXPECT_EQ(e.skeleton.frame_id, "sensor1");
+    const auto truth = sim.truth_at(e.t)[0];
+    for (auto j : {JointId::Torso, JointId::LeftShoulder, JointId::RightElbow}) {
+      EXPECT_EQ(e.skeleton[j].confidence, skeleton::kTracked);
+      // Without noise only the constant offset, the lag and the settling remain.
+      EXPECT_LT((world_from_sensor * e.skeleton[j].position - truth[j].position).norm(), 0.08);
+    }
+  }
+  EXPECT_GT(frames, 300);
+}
+
+TEST(SimTracker, BackToTheSensorFlipsLeftAndRight) {
+  auto cfg = one_sensor("360", "nite");
+  sim::Simulation sim(cfg);
+  const auto world_from_sensor = cfg.sensors[0].world_from_sensor();
+  const sim::SensorView view(cfg.sensors[0]);
+  int back_frames = 0, flipped = 0, front_frames = 0, front_flipped = 0;
+  for (const auto& e : sim.advance(sim.duration())) {
+    if (e.kind != sim::SimEvent::Kind::Raw) continue;
+    const auto scene = sim.scenario().at(e.t);
+    const double angle = view.view_angle(scene.actors[0].pose);
+    const auto truth = sim.truth_at(e.t)[0];
+    const Eigen::Vector3d reported_left = world_from_sensor * e.skeleton[JointId::LeftShoulder].position;
+    const bool swapped = (reported_left - truth[JointId::RightShoulder].position).norm() <
+                         (reported_left - truth[JointId::LeftShoulder].position).norm();
+    if (angle > 160 * kPi / 180) {
+      ++back_frames;
+      flipped += swapped ? 1 : 0;
+    } else if (angle < 20 * kPi / 180) {
+      ++front_frames;
+      front_flipped += swapped ? 1 : 0;
+    }
+  }
+  ASSERT_GT(back_frames, 30);
+  EXPECT_GT(flipped, back_frames * 8 / 10);
+  EXPECT_LT(front_flipped, front_frames / 10);
+}
+
+TEST(SimTracker, BehindTheWallThePersonIsLostAndComesBackWithANewId) {
+  for (const std::string profile : {"mssdk", "nite"}) {
+    SCOPED_TRACE(profile);
+    sim::Simulation sim(one_sensor("occ", profile));
+    std::set<std::uint32_t> ids;
+    int hidden_frames = 0, hidden_reported = 0;
+    for (const auto& e : sim.advance(sim.duration())) {
+      if (e.kind != sim::SimEvent::Kind::Raw) continue;
+      ids.insert(e.skeleton.person_id);
+    }
+    sim::Simulation again(one_sensor("occ", profile));
+    std::size_t raw = 0;
+    for (const auto& e : again.advance(again.duration())) raw += e.kind == sim::SimEvent::Kind::Raw ? 1 : 0;
+    // Three times behind the wall: three re-acquisitions, each a new user id.
+    EXPECT_EQ(ids.size(), 4u);
+    // Frames without any skeleton: the person was gone.
+    EXPECT_LT(raw, again.frame_count(0) * 9 / 10);
+    (void)hidden_frames;
+    (void)hidden_reported;
+  }
+}
+
+TEST(SimTracker, HiddenJointsAreInferredByMssdkButClaimedByNite) {
+  auto count = [](const std::string& profile) {
+    sim::Simulation sim(one_sensor("hide", profile));
+    int hidden = 0, claimed = 0;
+    for (const auto& e : sim.advance(sim.duration())) {
+      if (e.kind != sim::SimEvent::Kind::Raw) continue;
+      const auto phase = sim.scenario().at(e.t).actors[0].phase;
+      if (phase != "hide_left") continue;
+      ++hidden;
+      claimed += e.skeleton[JointId::LeftHand].confidence == skeleton::kTracked ? 1 : 0;
+    }
+    return std::pair{hidden, claimed};
+  };
+  const auto [ms_hidden, ms_claimed] = count("mssdk");
+  const auto [nite_hidden, nite_claimed] = count("nite");
+  ASSERT_GT(ms_hidden, 90);
+  EXPECT_LT(ms_claimed, ms_hidden / 3);
+  EXPECT_GT(nite_claimed, nite_hidden * 3 / 4);
+}
+
+TEST(Simulation, SeededRunsAreBitIdenticalAndSeedsDiffer) {
+  sim::SimConfig cfg;
+  cfg.scenario.name = "point";
+  cfg.scenario.people = 2;
+  cfg.scenario.seed = 11;
+  auto run = [](const sim::SimConfig& c) {
+    sim::Simulation s(c);
+    return s.advance(s.duration() + 1);
+  };
+  const auto a = run(cfg), b = run(cfg);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    ASSERT_EQ(a[i].t, b[i].t);
+    ASSERT_EQ(a[i].skeleton.stamp_ns, b[i].skeleton.stamp_ns);
+    ASSERT_EQ(a[i].skeleton.person_id, b[i].skeleton.person_id);
+    for (std::size_t j = 0; j < skeleton::kJointCount; ++j) {
+      ASSERT_EQ(a[i].skeleton.joints[j].position, b[i].skeleton.joints[j].position);  // exact
+      ASSERT_EQ(a[i].skeleton.joints[j].confidence, b[i].skeleton.joints[j].confidence);
+    }
+  }
+  cfg.scenario.seed = 12;
+  const auto c = run(cfg);
+  bool differs = c.size() != a.size();
+  for (std::size_t i = 0; !differs && i < a.size(); ++i) differs = a[i].skeleton.joints[0].position != c[i].skeleton.joints[0].position;
+  EXPECT_TRUE(differs);
+}
+
+TEST(Simulation, TruthAndRawInTimeOrderOnTheirOwnClocks) {
+  sim::SimConfig cfg;
+  cfg.scenario.name = "walk";
+  cfg.epoch_ns = 5'000'000'000;
+  sim::Simulation sim(cfg);
+  std::size_t truth = 0;
+  std::map<std::size_t, std::size_t> raw;
+  double last = -1;
+  // In slices, as the component does.
+  for (double t = 0.1; !sim.finished(); t += 0.1) {
+    for (const auto& e : sim.advance(t)) {
+      ASSERT_GE(e.t, last);
+      ASSERT_LT(e.t, t);
+      last = e.t;
+      if (e.kind == sim::SimEvent::Kind::Truth) {
+        ++truth;
+        EXPECT_EQ(e.skeleton.frame_id, "world");
+        EXPECT_EQ(e.skeleton.stamp_ns, cfg.epoch_ns + std::llround(e.t * 1e9));
+      } else {
+        ++raw[e.sensor];
+        const auto& sc = cfg.sensors[e.sensor];
+        EXPECT_EQ(e.skeleton.sensor_id, sc.id);
+        EXPECT_EQ(e.skeleton.stamp_ns, cfg.epoch_ns + std::llround((e.t + sc.clock_offset_s) * 1e9));
+      }
+    }
+  }
+  const double expected = sim.duration() * 30.0;
+  EXPECT_NEAR(static_cast<double>(truth), expected, 2);
+  ASSERT_EQ(raw.size(), 2u);
+  // Every delivered frame has the person once tracking has begun (under a second).
+  for (const auto& [sensor, n] : raw) {
+    EXPECT_LE(n, sim.frame_count(sensor));
+    EXPECT_GT(n + 30, sim.frame_count(sensor));
+    EXPECT_NEAR(static_cast<double>(sim.frame_count(sensor)), expected * 0.99, expected * 0.02);
+  }
+}
+
+TEST(Simulation, RejectsBadConfigurations) {
+  sim::SimConfig cfg;
+  cfg.profile = "kinect7";
+  EXPECT_THROW(sim::Simulation{cfg}, std::invalid_argument);
+  cfg = {};
+  cfg.sensors = {};
+  EXPECT_THROW(sim::Simulation{cfg}, std::invalid_argument);
+  cfg = {};
+  cfg.sensors[1].id = cfg.sensors[0].id;
+  EXPECT_THROW(sim::Simulation{cfg}, std::invalid_argument);
+}
