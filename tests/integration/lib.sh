@@ -19,6 +19,9 @@ sys.exit(0 if eval(sys.argv[2]) else 1)
 PY
 }
 
+# json_get FILE PYTHON_EXPR: prints the expression's value (for messages).
+json_get() { python3 -c 'import json, sys; d = json.load(open(sys.argv[1])); print(eval(sys.argv[2]))' "$1" "$2"; }
+
 # wait_for_match FILE PATTERN SECONDS: waits (bounded, polling) until FILE has a line matching PATTERN.
 wait_for_match() {
   local file=$1 pattern=$2 deadline=$((SECONDS + $3))

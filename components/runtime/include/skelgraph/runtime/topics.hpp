@@ -41,7 +41,9 @@ inline const TopicDef<msg::Skeleton> kSkeletonRaw{"skelgraph/skeleton/raw", {R::
 inline const TopicDef<msg::Skeleton> kSkeletonFused{"skelgraph/skeleton/fused", {R::BestEffort, D::Volatile, 5}};
 inline const TopicDef<msg::Skeleton> kSkeletonTruth{"skelgraph/skeleton/truth", {R::Reliable, D::Volatile, 64}};
 inline const TopicDef<msg::DepthFrame> kDepth{"skelgraph/depth", {R::BestEffort, D::Volatile, 2}};
-inline const TopicDef<msg::SensorPose> kCalibration{"skelgraph/calibration", {R::Reliable, D::TransientLocal, 1}};
+// Keyed by sensor; the depth keeps every sensor's latest pose for readers
+// that do not know the key (generic tools such as `topic echo`).
+inline const TopicDef<msg::SensorPose> kCalibration{"skelgraph/calibration", {R::Reliable, D::TransientLocal, 32}};
 inline const TopicDef<msg::GestureEvent> kGestureEvent{"skelgraph/gesture/event", {R::Reliable, D::Volatile, 0}};
 inline const TopicDef<msg::ComponentStatus> kStatus{"skelgraph/status", {R::BestEffort, D::Volatile, 1}};
 

@@ -39,6 +39,8 @@ class Simulation {
  public:
   explicit Simulation(SimConfig config);  // throws std::invalid_argument on a bad configuration
   ~Simulation();
+  Simulation(const Simulation&) = delete;
+  Simulation& operator=(const Simulation&) = delete;
 
   const SimConfig& config() const { return cfg_; }
   const Scenario& scenario() const { return scenario_; }
