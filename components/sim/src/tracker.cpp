@@ -111,6 +111,7 @@ TrackerProfile make_mssdk() {
   p.acquire_s = 0.2;
   p.reacquire_s = 1.0;
   p.ghost_s = 0.15;
+  p.out_of_view_lost = true;
   p.ghost_on_prop_s = 0.15;
   p.settle_sd = 0.15;
   p.settle_s = 0.7;
@@ -420,7 +421,8 @@ std::optional<skeleton::Skeleton> TrackerModel::observe(double t, const Scene& s
 
     float conf = skeleton::kTracked;
     if (!vis.in_view[src]) {
-      conf = skeleton::kInferred;
+      // Outside the image: guessed from the rest of the body, or given up on.
+      conf = p_.out_of_view_lost ? skeleton::kLost : skeleton::kInferred;
       pos += hidden_bias_[j];
     } else if (vis.object_hidden[src] && side_of(jid) == 0) {
       // Head, neck and torso follow from the rest of the body: still claimed, inferred with an error.

@@ -29,6 +29,7 @@ struct TrackerProfile {
   double ghost_on_prop_s = 0.2;     // ... or this long once it has latched onto a prop
   double settle_sd = 0.15, settle_s = 0.7;  // a fresh skeleton starts this wrong (m) and settles in this time
   // Confidence.
+  bool out_of_view_lost = false;        // joints outside the image: 0 (else 0.5)
   double self_hidden_tracked = 0.0;     // share of time a joint hidden behind the body still claims 1
   double object_hidden_tracked = 0.0;   // ... hidden behind a wall or a box
   double near_object_inferred = 0.0;    // share of time a joint touching an object drops to 0.5
