@@ -7,13 +7,6 @@
 
 namespace skelgraph::playback {
 
-namespace {
-std::int64_t mono_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
-}  // namespace
-
 runtime::ComponentInfo Playback::describe() {
   runtime::ComponentInfo info{"playback", "Replays recorded skeleton data sets on skelgraph/skeleton/raw", {}};
   info.params.add_string("format", "generic", "file format", format_names())
@@ -52,13 +45,13 @@ Playback::Playback(runtime::Context& ctx, const runtime::Params& params)
 }
 
 void Playback::on_start() {
-  start_mono_ns_ = mono_ns();
+  start_mono_ns_ = runtime::Context::monotonic_ns();
   start_stamp_ns_ = runtime::Context::now_ns();
   timer_ = ctx_.executor().every(std::chrono::milliseconds(2), [this] { tick(); }, true);
 }
 
 void Playback::tick() {
-  for (const auto& s : schedule_->due(mono_ns() - start_mono_ns_, start_stamp_ns_)) pub_.publish(skeleton::to_msg(s));
+  for (const auto& s : schedule_->due(runtime::Context::monotonic_ns() - start_mono_ns_, start_stamp_ns_)) pub_.publish(skeleton::to_msg(s));
   if (schedule_->finished()) {
     timer_.cancel();
     ctx_.set_health(runtime::HealthState::Ok, "finished");

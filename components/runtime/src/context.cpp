@@ -85,6 +85,12 @@ std::int64_t Context::now_ns() {
       .count();
 }
 
+std::int64_t Context::monotonic_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
 dds::Publisher& Context::publisher() {
   std::lock_guard<std::mutex> lock(mutex_);
   if (publisher_ == nullptr) {

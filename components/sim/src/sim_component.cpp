@@ -8,13 +8,6 @@
 
 namespace skelgraph::sim {
 
-namespace {
-std::int64_t mono_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
-}  // namespace
-
 void add_sim_params(runtime::ParamSchema& schema) {
   schema.add_string("scenario", "walk", "what the people do", scenario_names())
       .add_int("repeats", 1, "times the scenario is performed in a row", 1, 1000)
@@ -91,7 +84,7 @@ void SimComponent::publish_poses() {
 }
 
 void SimComponent::on_start() {
-  start_mono_ns_ = mono_ns();
+  start_mono_ns_ = runtime::Context::monotonic_ns();
   config_.epoch_ns = runtime::Context::now_ns();
   sim_ = std::make_unique<Simulation>(config_);
   publish_poses();
@@ -99,7 +92,7 @@ void SimComponent::on_start() {
 }
 
 void SimComponent::tick() {
-  const double t = static_cast<double>(mono_ns() - start_mono_ns_) * 1e-9 * rate_ - loop_offset_s_;
+  const double t = static_cast<double>(runtime::Context::monotonic_ns() - start_mono_ns_) * 1e-9 * rate_ - loop_offset_s_;
   for (const auto& e : sim_->advance(t)) {
     if (e.kind == SimEvent::Kind::Truth) {
       truth_pub_.publish(skeleton::to_msg(e.skeleton));

@@ -6,6 +6,20 @@ static_assert(kJointCount == msg::JOINT_COUNT, "canonical joints and the IDL dis
 static_assert(static_cast<int>(JointId::RightFoot) == msg::JOINT_RIGHT_FOOT, "joint order differs from the IDL");
 static_assert(static_cast<int>(JointId::LeftHand) == msg::JOINT_LEFT_HAND, "joint order differs from the IDL");
 
+namespace {
+void set(msg::Vec3& m, const Eigen::Vector3d& v) {
+  m.x(v.x());
+  m.y(v.y());
+  m.z(v.z());
+}
+void set(msg::Quat& m, const Eigen::Quaterniond& q) {
+  m.w(q.w());
+  m.x(q.x());
+  m.y(q.y());
+  m.z(q.z());
+}
+}  // namespace
+
 msg::Skeleton to_msg(const Skeleton& s) {
   msg::Skeleton m;
   m.sensor_id(s.sensor_id.substr(0, 64));
@@ -16,13 +30,8 @@ msg::Skeleton to_msg(const Skeleton& s) {
   for (std::size_t i = 0; i < kJointCount; ++i) {
     const auto& j = s.joints[i];
     auto& o = m.joints()[i];
-    o.position().x(j.position.x());
-    o.position().y(j.position.y());
-    o.position().z(j.position.z());
-    o.orientation().w(j.orientation.w());
-    o.orientation().x(j.orientation.x());
-    o.orientation().y(j.orientation.y());
-    o.orientation().z(j.orientation.z());
+    set(o.position(), j.position);
+    set(o.orientation(), j.orientation);
     o.confidence(j.confidence);
     o.sensor_mask(j.sensor_mask);
   }
@@ -51,15 +60,8 @@ msg::SensorPose to_msg(const SensorPose& p) {
   msg::SensorPose m;
   m.sensor_id(p.sensor_id.substr(0, 64));
   m.frame_id(p.frame_id.substr(0, 64));
-  const Eigen::Vector3d t = p.pose.translation();
-  const Eigen::Quaterniond q(p.pose.rotation());
-  m.translation().x(t.x());
-  m.translation().y(t.y());
-  m.translation().z(t.z());
-  m.rotation().w(q.w());
-  m.rotation().x(q.x());
-  m.rotation().y(q.y());
-  m.rotation().z(q.z());
+  set(m.translation(), p.pose.translation());
+  set(m.rotation(), Eigen::Quaterniond(p.pose.rotation()));
   m.stamp_ns(p.stamp_ns);
   m.method(p.method.substr(0, 64));
   m.rms_residual_m(p.rms_residual_m);

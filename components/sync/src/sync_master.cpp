@@ -47,10 +47,7 @@ SyncMaster::SyncMaster(runtime::Context& ctx, const runtime::Params& params)
       control_sub_(ctx, runtime::topics::kSyncControl,
                    [this](const msg::SyncControl& c, const runtime::SampleMeta&) { on_control(c); }) {}
 
-std::int64_t SyncMaster::mono_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
+std::int64_t SyncMaster::mono_ns() { return runtime::Context::monotonic_ns(); }
 
 void SyncMaster::start_session(const std::string& label, const std::string& request_id) {
   // The timer starts with the session, so each firing finds exactly one tick due.

@@ -65,6 +65,8 @@ class Context {
 
   // Wall-clock time in ns since the Unix epoch: message stamps.
   static std::int64_t now_ns();
+  // Monotonic time in ns (arbitrary origin): pacing and intervals.
+  static std::int64_t monotonic_ns();
 
   // Shared DDS entities, created on first use.
   eprosima::fastdds::dds::Publisher& publisher();
