@@ -3,6 +3,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "skelgraph/msg/cdr.hpp"
 #include "skelgraph/msg/json.hpp"
 #include "skelgraph/msg/messages.hpp"
 
@@ -18,22 +19,7 @@ MessageInfo make_info() {
   info.keyed = T::isKeyDefined();
   info.make_type_support = [] { return new Support(); };
   info.decode = [](const std::vector<std::uint8_t>& bytes) {
-    Support support;
-    eprosima::fastrtps::rtps::SerializedPayload_t payload(static_cast<std::uint32_t>(bytes.size()));
-    std::copy(bytes.begin(), bytes.end(), payload.data);
-    payload.length = static_cast<std::uint32_t>(bytes.size());
-    T value;
-    bool ok = false;
-    try {
-      ok = support.deserialize(&payload, &value);
-    } catch (const std::exception&) {
-      ok = false;
-    }
-    if (!ok) {
-      throw std::runtime_error("cannot decode " + std::to_string(bytes.size()) + " bytes as " +
-                               MessageTraits<T>::name);
-    }
-    return nlohmann::json(value);
+    return nlohmann::json(from_cdr<T>(bytes.data(), bytes.size()));
   };
   return info;
 }

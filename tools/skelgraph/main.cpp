@@ -110,6 +110,7 @@ int main(int argc, char** argv) {
   add_demo_command(app, g, run);
   add_components_command(app, g, run);
   add_sim_command(app, g, run);
+  add_bag_command(app, g, run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,267 @@
+// skelgraph bag info|import|export|recover: MCAP recordings without DDS.
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <map>
+#include <set>
+
+#include <nlohmann/json.hpp>
+
+#include "cli.hpp"
+#include "skelgraph/mcap/mcap.hpp"
+#include "skelgraph/msg/cdr.hpp"
+#include "skelgraph/playback/readers.hpp"
+#include "skelgraph/recording/bag.hpp"
+#include "skelgraph/runtime/topics.hpp"
+#include "skelgraph/skeleton/skeleton_msg.hpp"
+
+namespace skelgraph::cli {
+
+namespace {
+
+// A bad file is the user's input: exit 2 with what and where.
+template <class F>
+auto user_input(F&& f) {
+  try {
+    return f();
+  } catch (const mcap::McapError& e) {
+    throw UsageError(e.what());
+  } catch (const playback::DataError& e) {
+    throw UsageError(e.what());
+  }
+}
+
+int info(const std::string& file, bool json) {
+  const mcap::Reader reader = user_input([&] { return mcap::Reader(file); });
+  std::string problem;
+  try {
+    reader.validate();
+  } catch (const mcap::McapError& e) {
+    problem = e.what();
+  }
+  const auto s = user_input([&] { return reader.summary(); });
+  // Ticks and sessions from the sync topic.
+  std::uint64_t ticks = 0;
+  std::set<std::uint32_t> sessions;
+  std::map<std::string, std::uint64_t> per_sensor;
+  reader.for_each_message([&](const mcap::Channel& ch, const mcap::Schema* schema, const mcap::Message& m) {
+    if (schema == nullptr) return;
+    if (ch.topic == runtime::topics::kSync.name && schema->name == msg::MessageTraits<msg::SyncCommand>::name) {
+      const auto c = msg::from_cdr<msg::SyncCommand>(m.data.data(), m.data.size());
+      if (c.kind() == msg::SYNC_TICK) ++ticks;
+      sessions.insert(c.session_id());
+    } else if (schema->name == msg::MessageTraits<msg::Skeleton>::name) {
+      const auto k = msg::from_cdr<msg::Skeleton>(m.data.data(), m.data.size());
+      ++per_sensor[ch.topic + " " + k.sensor_id().to_string()];
+    }
+  });
+  const double duration =
+      s.message_count > 1 ? static_cast<double>(s.message_end_time - s.message_start_time) * 1e-9 : 0.0;
+  nlohmann::json topics = nlohmann::json::array();
+  for (const auto& [id, ch] : s.channels) {
+    const auto count = s.channel_message_counts.count(id) ? s.channel_message_counts.at(id) : 0;
+    const auto it = ch.metadata.find("dds_type");
+    topics.push_back({{"topic", ch.topic},
+                      {"type", it != ch.metadata.end() ? it->second : ""},
+                      {"count", count},
+                      {"rate_hz", duration > 0 ? static_cast<double>(count) / duration : 0.0}});
+  }
+  nlohmann::json metadata = nlohmann::json::array();
+  for (const auto& m : s.metadata) metadata.push_back({{"name", m.name}, {"values", m.values}});
+  const nlohmann::json out{{"file", file},
+                           {"valid", problem.empty()},
+                           {"problem", problem},
+                           {"size_bytes", reader.size()},
+                           {"library", s.library},
+                           {"messages", s.message_count},
+                           {"chunks", s.chunk_count},
+                           {"start_ns", s.message_start_time},
+                           {"end_ns", s.message_end_time},
+                           {"duration_s", duration},
+                           {"ticks", ticks},
+                           {"sessions", sessions},
+                           {"topics", topics},
+                           {"skeletons_per_sensor", per_sensor},
+                           {"metadata", metadata}};
+  if (json) {
+    std::printf("%s\n", out.dump(2).c_str());
+  } else {
+    std::printf("file:      %s (%llu bytes, %s)\n", file.c_str(), static_cast<unsigned long long>(reader.size()),
+                problem.empty() ? "valid" : ("INVALID: " + problem).c_str());
+    std::printf("duration:  %.3f s, %llu messages in %llu chunks, %llu ticks\n", duration,
+                static_cast<unsigned long long>(s.message_count), static_cast<unsigned long long>(s.chunk_count),
+                static_cast<unsigned long long>(ticks));
+    for (const auto& t : topics) {
+      std::printf("  %-32s %-34s %8llu msgs %8.2f Hz\n", t["topic"].get<std::string>().c_str(),
+                  t["type"].get<std::string>().c_str(), t["count"].get<unsigned long long>(), t["rate_hz"].get<double>());
+    }
+    for (const auto& [k, n] : per_sensor) std::printf("  skeletons %-40s %8llu\n", k.c_str(), static_cast<unsigned long long>(n));
+    for (const auto& m : s.metadata) {
+      std::printf("  metadata %s:", m.name.c_str());
+      for (const auto& [k, v] : m.values) std::printf(" %s=%s", k.c_str(), v.c_str());
+      std::printf("\n");
+    }
+  }
+  return problem.empty() ? 0 : 1;
+}
+
+int import(playback::Format format, const std::vector<std::string>& files, const playback::ReadOptions& opt,
+           const std::string& out, mcap::Compression compression, bool json) {
+  mcap::WriterOptions wo;
+  wo.compression = compression;
+  recording::BagWriter bag(out, wo);
+  std::uint64_t frames = 0;
+  for (const auto& f : files) {
+    const auto rec = user_input([&] { return playback::read_recording(format, f, opt); });
+    mcap::KeyValues meta = rec.metadata;
+    meta["format"] = rec.format;
+    meta["source"] = f;
+    bag.write_metadata("import", meta);
+    for (const auto& s : rec.frames) {
+      if (s.stamp_ns < 0) throw UsageError(f + ": negative time stamp " + std::to_string(s.stamp_ns) + " cannot be recorded");
+      const auto t = static_cast<std::uint64_t>(s.stamp_ns);
+      bag.write(runtime::topics::kSkeletonRaw.name, skeleton::to_msg(s), t, t);
+      ++frames;
+    }
+    if (!json) std::fprintf(stderr, "%s: %zu frames\n", f.c_str(), rec.frames.size());
+  }
+  bag.close();
+  if (json) std::printf("%s\n", nlohmann::json{{"out", out}, {"frames", frames}, {"files", files}}.dump(2).c_str());
+  else std::printf("%s: %llu skeletons from %zu file(s)\n", out.c_str(), static_cast<unsigned long long>(frames), files.size());
+  return 0;
+}
+
+std::string file_safe(std::string s) {
+  for (auto& c : s) {
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_' && c != '.') c = '_';
+  }
+  return s;
+}
+
+// generic: our lossless CSV (reads back with the generic reader). csv: plain
+// numeric columns per sensor, one line per frame, as the thesis's per-Kinect
+// text logs were: time, person, then x, y, z, confidence of every joint.
+int export_bag(const std::string& file, const std::string& format, const std::string& dir, bool json) {
+  const mcap::Reader reader = user_input([&] { return mcap::Reader(file); });
+  std::map<std::string, playback::Recording> by_stream;  // "<topic tail>_<sensor>"
+  user_input([&] {
+    reader.for_each_message([&](const mcap::Channel& ch, const mcap::Schema* schema, const mcap::Message& m) {
+      if (schema == nullptr || schema->name != msg::MessageTraits<msg::Skeleton>::name) return;
+      auto s = skeleton::from_msg(msg::from_cdr<msg::Skeleton>(m.data.data(), m.data.size()));
+      const auto tail = ch.topic.substr(ch.topic.rfind('/') + 1);
+      auto& rec = by_stream[file_safe(tail + "_" + s.sensor_id)];
+      rec.format = "generic";
+      rec.metadata["topic"] = ch.topic;
+      rec.metadata["source"] = file;
+      rec.frames.push_back(std::move(s));
+    });
+    return 0;
+  });
+  std::filesystem::create_directories(dir);
+  nlohmann::json written = nlohmann::json::object();
+  for (auto& [name, rec] : by_stream) {
+    const auto path = std::filesystem::path(dir) / (name + ".csv");
+    std::ofstream out(path);
+    if (!out) throw std::runtime_error("cannot write " + path.string());
+    if (format == "generic") {
+      playback::write_generic_csv(rec, out);
+    } else {
+      out << "stamp_ns,time_s,person_id,frame_number";
+      for (std::size_t j = 0; j < skeleton::kJointCount; ++j) {
+        const std::string n = skeleton::joint_name(skeleton::joint_at(j));
+        out << "," << n << "_x," << n << "_y," << n << "_z," << n << "_conf";
+      }
+      out << "\n" << std::setprecision(9);
+      const auto t0 = rec.frames.empty() ? 0 : rec.frames.front().stamp_ns;
+      for (const auto& s : rec.frames) {
+        out << s.stamp_ns << "," << static_cast<double>(s.stamp_ns - t0) * 1e-9 << "," << s.person_id << ","
+            << s.frame_number;
+        for (const auto& j : s.joints) {
+          out << "," << j.position.x() << "," << j.position.y() << "," << j.position.z() << "," << j.confidence;
+        }
+        out << "\n";
+      }
+    }
+    if (!out.flush()) throw std::runtime_error("error writing " + path.string());
+    written[path.string()] = rec.frames.size();
+  }
+  if (json) std::printf("%s\n", nlohmann::json{{"files", written}}.dump(2).c_str());
+  else for (const auto& [p, n] : written.items()) std::printf("%s: %s frames\n", p.c_str(), n.dump().c_str());
+  return 0;
+}
+
+int recover(const std::string& in, const std::string& out, bool json) {
+  const auto rep = user_input([&] { return mcap::recover(in, out); });
+  const double lost = rep.input_size > 0 ? 100.0 * static_cast<double>(rep.input_size - rep.bytes_read) / rep.input_size : 0;
+  if (json) {
+    std::printf("%s\n", nlohmann::json{{"in", in},
+                                       {"out", out},
+                                       {"messages", rep.messages},
+                                       {"chunks", rep.chunks},
+                                       {"bytes_read", rep.bytes_read},
+                                       {"input_size", rep.input_size},
+                                       {"stopped_because", rep.stopped_because}}
+                            .dump(2)
+                            .c_str());
+  } else {
+    std::printf("%s: %llu messages in %llu chunks recovered from %s (%.1f %% of its bytes unusable)\n", out.c_str(),
+                static_cast<unsigned long long>(rep.messages), static_cast<unsigned long long>(rep.chunks), in.c_str(), lost);
+    if (!rep.stopped_because.empty()) std::printf("stopped: %s\n", rep.stopped_because.c_str());
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_bag_command(CLI::App& app, GlobalOptions&, Action& run) {
+  auto* bag = app.add_subcommand("bag", "MCAP recordings: info, import, export, recover");
+  bag->require_subcommand(1);
+  struct Opts {
+    std::string file, out, format = "csv", compression = "zstd", on_error = "stop", sensor_id;
+    std::vector<std::string> files;
+    bool json = false;
+  };
+  auto o = std::make_shared<Opts>();
+
+  auto* i = bag->add_subcommand("info", "What a recording holds: duration, topics with counts and rates, ticks, sessions, metadata; exit 1 if the file is damaged");
+  i->add_option("file", o->file, "MCAP file")->required()->check(CLI::ExistingFile);
+  i->add_flag("--json", o->json, "machine-readable output");
+  i->callback([o, &run] { run = [o] { return info(o->file, o->json); }; });
+
+  auto* im = bag->add_subcommand("import", "Data-set files (the playback formats) into an MCAP recording on skelgraph/skeleton/raw");
+  im->add_option("format", o->format, "file format")->required()->check(CLI::IsMember(playback::format_names()));
+  im->add_option("files", o->files, "files to import")->required()->check(CLI::ExistingFile);
+  im->add_option("--out", o->out, "MCAP file to write")->required();
+  im->add_option("--compression", o->compression, "chunk compression")->check(CLI::IsMember({"none", "lz4", "zstd"}));
+  im->add_option("--on-error", o->on_error, "a bad line: stop (default) or skip it")->check(CLI::IsMember({"stop", "skip"}));
+  im->add_option("--sensor-id", o->sensor_id, "sensor id to record under (multitrack: a prefix)");
+  im->add_flag("--json", o->json, "machine-readable summary");
+  im->callback([o, &run] {
+    run = [o] {
+      playback::ReadOptions opt;
+      opt.on_error = o->on_error == "skip" ? playback::ReadOptions::OnError::Skip : playback::ReadOptions::OnError::Stop;
+      opt.sensor_id = o->sensor_id;
+      return import(*playback::format_from_name(o->format), o->files, opt, o->out,
+                    *mcap::compression_from_name(o->compression), o->json);
+    };
+  });
+
+  auto* ex = bag->add_subcommand("export", "Skeletons of a recording to CSV files, one per topic and sensor");
+  ex->add_option("file", o->file, "MCAP file")->required()->check(CLI::ExistingFile);
+  ex->add_option("--format", o->format, "csv: numeric columns (x, y, z, confidence per joint); generic: skelgraph's lossless CSV")
+      ->check(CLI::IsMember({"csv", "generic"}));
+  ex->add_option("--out", o->out, "output directory")->required();
+  ex->add_flag("--json", o->json, "machine-readable summary");
+  ex->callback([o, &run] { run = [o] { return export_bag(o->file, o->format, o->out, o->json); }; });
+
+  auto* rc = bag->add_subcommand("recover", "Salvage every complete chunk of a recording whose writer was killed");
+  rc->add_option("file", o->file, "damaged MCAP file")->required()->check(CLI::ExistingFile);
+  rc->add_option("--out", o->out, "MCAP file to write")->required();
+  rc->add_flag("--json", o->json, "machine-readable summary");
+  rc->callback([o, &run] { run = [o] { return recover(o->file, o->out, o->json); }; });
+}
+
+}  // namespace skelgraph::cli
