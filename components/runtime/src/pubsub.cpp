@@ -185,4 +185,21 @@ bool ReaderBase::wait_for_matched(std::size_t n, std::chrono::milliseconds timeo
   return state_->counter->wait_matched(n, timeout);
 }
 
+std::shared_ptr<dds::TopicDataType> RawSubscription::registered_type(Context& ctx, const std::string& topic,
+                                                                   const std::string& type_name, bool keyed) {
+  ctx.topic(topic, new msg::RawPubSubType(type_name, keyed));  // registers the raw support unless one exists
+  return ctx.participant().find_type(type_name);
+}
+
+void RawSubscription::deliver(void* sample, const SampleMeta& m) {
+  if (dynamic_cast<msg::RawPubSubType*>(type_.get()) != nullptr) {
+    cb_(*static_cast<const msg::RawSample*>(sample), m);
+    return;
+  }
+  eprosima::fastrtps::rtps::SerializedPayload_t payload(type_->getSerializedSizeProvider(sample)());
+  if (!type_->serialize(sample, &payload)) return;
+  scratch_.payload.assign(payload.data, payload.data + payload.length);
+  cb_(scratch_, m);
+}
+
 }  // namespace skelgraph::runtime

@@ -107,22 +107,32 @@ class Subscription {
   ReaderBase base_;
 };
 
-// Receives any topic as serialized CDR, without knowing its type.
+// Receives any topic as serialized CDR, without knowing its type. A
+// participant has one type support per type name: when this one already
+// reads or writes the type typed (a component recording its own status), the
+// typed sample is serialized back, so the callback always gets the payload.
 class RawSubscription {
  public:
   using Callback = std::function<void(const msg::RawSample&, const SampleMeta&)>;
   RawSubscription(Context& ctx, const std::string& topic, const std::string& type_name, bool keyed,
                   const QosPreset& qos, Callback cb)
-      : base_(ctx, topic, new msg::RawPubSubType(type_name, keyed), qos,
-              [cb = std::move(cb)](void* s, const SampleMeta& m) {
-                cb(*static_cast<const msg::RawSample*>(s), m);
-              }) {}
+      : cb_(std::move(cb)),
+        type_(registered_type(ctx, topic, type_name, keyed)),
+        base_(ctx, topic, new msg::RawPubSubType(type_name, keyed), qos,
+              [this](void* s, const SampleMeta& m) { deliver(s, m); }) {}
   std::size_t matched() const { return base_.matched(); }
   bool wait_for_matched(std::size_t n, std::chrono::milliseconds timeout) const {
     return base_.wait_for_matched(n, timeout);
   }
 
  private:
+  static std::shared_ptr<eprosima::fastdds::dds::TopicDataType> registered_type(Context& ctx, const std::string& topic,
+                                                                                const std::string& type_name, bool keyed);
+  void deliver(void* sample, const SampleMeta& m);
+
+  Callback cb_;
+  std::shared_ptr<eprosima::fastdds::dds::TopicDataType> type_;
+  msg::RawSample scratch_;
   ReaderBase base_;
 };
 
