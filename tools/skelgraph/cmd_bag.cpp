@@ -11,6 +11,8 @@
 #include <nlohmann/json.hpp>
 
 #include "cli.hpp"
+#include "run_graph.hpp"
+#include "skelgraph/runtime/registry.hpp"
 #include "skelgraph/mcap/mcap.hpp"
 #include "skelgraph/msg/cdr.hpp"
 #include "skelgraph/playback/readers.hpp"
@@ -216,8 +218,23 @@ int recover(const std::string& in, const std::string& out, bool json) {
 
 }  // namespace
 
-void add_bag_command(CLI::App& app, GlobalOptions&, Action& run) {
-  auto* bag = app.add_subcommand("bag", "MCAP recordings: info, import, export, recover");
+// Runs one component of `kind` with parameters given as text.
+int run_component(GlobalOptions& g, const std::string& kind, const std::vector<runtime::RawParam>& raw,
+                  const RunOptions& ro) {
+  const auto registry = runtime::builtin_registry();
+  runtime::ResolvedComponent c;
+  c.name = kind;
+  c.kind = kind;
+  try {
+    c.params = registry.find(kind)->info.params.resolve(raw, "bag");
+  } catch (const runtime::ParamError& e) {
+    throw UsageError(e.what());
+  }
+  return user_input([&] { return run_graph(registry, make_config(g), {c}, ro, nullptr); });
+}
+
+void add_bag_command(CLI::App& app, GlobalOptions& g, Action& run) {
+  auto* bag = app.add_subcommand("bag", "MCAP recordings: record, play, info, import, export, recover");
   bag->require_subcommand(1);
   struct Opts {
     std::string file, out, format = "csv", compression = "zstd", on_error = "stop", sensor_id;
@@ -225,6 +242,55 @@ void add_bag_command(CLI::App& app, GlobalOptions&, Action& run) {
     bool json = false;
   };
   auto o = std::make_shared<Opts>();
+
+  struct RecOpts {
+    std::string dir = "recordings", label = "manual", compression = "zstd", host;
+    std::vector<std::string> topics;
+    bool now = false, depth = false;
+    double rate = 1.0;
+    bool loop = false;
+    RunOptions run;
+  };
+  auto r = std::make_shared<RecOpts>();
+  auto* rec = bag->add_subcommand("record", "Record skelgraph topics to MCAP: a file per sync session (START..STOP), or from now with --now");
+  rec->add_option("--dir", r->dir, "directory for the files");
+  rec->add_flag("--now", r->now, "record from now until stopped, without waiting for the sync topic");
+  rec->add_option("--label", r->label, "session label with --now");
+  rec->add_option("--topics", r->topics, "topics to record (default: every skelgraph topic but depth)");
+  rec->add_flag("--include-depth", r->depth, "also record skelgraph/depth");
+  rec->add_option("--compression", r->compression, "chunk compression")->check(CLI::IsMember({"none", "lz4", "zstd"}));
+  rec->add_option("--host", r->host, "host name for file names and acks (default: this host)");
+  add_run_options(*rec, r->run);
+  add_dds_options(*rec, g);
+  rec->callback([r, &g, &run] {
+    run = [r, &g] {
+      std::vector<runtime::RawParam> raw = {{"directory", r->dir, "bag record"},
+                                            {"now", r->now ? "true" : "false", "bag record"},
+                                            {"label", r->label, "bag record"},
+                                            {"include_depth", r->depth ? "true" : "false", "bag record"},
+                                            {"compression", r->compression, "bag record"},
+                                            {"host", r->host, "bag record"}};
+      if (!r->topics.empty()) raw.push_back({"topics", r->topics, "bag record"});
+      return run_component(g, "recorder", raw, r->run);
+    };
+  });
+
+  auto* pl = bag->add_subcommand("play", "Republish a recording with its original timing, topics and keys");
+  pl->add_option("file", o->file, "MCAP file")->required()->check(CLI::ExistingFile);
+  pl->add_option("--rate", r->rate, "1 = as recorded, 2 = twice as fast")->check(kPositive);
+  pl->add_flag("--loop", r->loop, "start again at the end");
+  pl->add_option("--topics", r->topics, "only these topics (default: all but skelgraph/status)");
+  add_run_options(*pl, r->run);
+  add_dds_options(*pl, g);
+  pl->callback([o, r, &g, &run] {
+    run = [o, r, &g] {
+      std::vector<runtime::RawParam> raw = {{"file", o->file, "bag play"},
+                                            {"rate", std::to_string(r->rate), "bag play"},
+                                            {"loop", r->loop ? "true" : "false", "bag play"}};
+      if (!r->topics.empty()) raw.push_back({"topics", r->topics, "bag play"});
+      return run_component(g, "bag_player", raw, r->run);
+    };
+  });
 
   auto* i = bag->add_subcommand("info", "What a recording holds: duration, topics with counts and rates, ticks, sessions, metadata; exit 1 if the file is damaged");
   i->add_option("file", o->file, "MCAP file")->required()->check(CLI::ExistingFile);

@@ -185,10 +185,35 @@ bool ReaderBase::wait_for_matched(std::size_t n, std::chrono::milliseconds timeo
   return state_->counter->wait_matched(n, timeout);
 }
 
-std::shared_ptr<dds::TopicDataType> RawSubscription::registered_type(Context& ctx, const std::string& topic,
-                                                                   const std::string& type_name, bool keyed) {
+std::shared_ptr<dds::TopicDataType> registered_raw_type(Context& ctx, const std::string& topic,
+                                                        const std::string& type_name, bool keyed) {
   ctx.topic(topic, new msg::RawPubSubType(type_name, keyed));  // registers the raw support unless one exists
   return ctx.participant().find_type(type_name);
+}
+
+RawPublisher::RawPublisher(Context& ctx, const std::string& topic, const std::string& type_name, bool keyed,
+                           const QosPreset& qos)
+    : type_(registered_raw_type(ctx, topic, type_name, keyed)),
+      base_(ctx, topic, new msg::RawPubSubType(type_name, keyed), qos) {
+  if (dynamic_cast<msg::RawPubSubType*>(type_.get()) == nullptr) typed_ = type_->createData();
+}
+
+RawPublisher::~RawPublisher() {
+  if (typed_ != nullptr) type_->deleteData(typed_);
+}
+
+bool RawPublisher::publish(const msg::RawSample& sample) {
+  if (typed_ == nullptr) return base_.write(const_cast<msg::RawSample*>(&sample));
+  eprosima::fastrtps::rtps::SerializedPayload_t payload(static_cast<std::uint32_t>(sample.payload.size()));
+  std::copy(sample.payload.begin(), sample.payload.end(), payload.data);
+  payload.length = static_cast<std::uint32_t>(sample.payload.size());
+  bool ok = false;
+  try {
+    ok = type_->deserialize(&payload, typed_);
+  } catch (const std::exception&) {
+    ok = false;
+  }
+  return ok && base_.write(typed_);
 }
 
 void RawSubscription::deliver(void* sample, const SampleMeta& m) {

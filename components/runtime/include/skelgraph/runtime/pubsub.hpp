@@ -107,6 +107,30 @@ class Subscription {
   ReaderBase base_;
 };
 
+// Registers the raw support for `type_name` unless the participant has one;
+// returns the support the participant uses for that name.
+std::shared_ptr<eprosima::fastdds::dds::TopicDataType> registered_raw_type(Context& ctx, const std::string& topic,
+                                                                           const std::string& type_name, bool keyed);
+
+// Publishes serialized CDR on any topic, without knowing its type (bag play).
+// Where this participant already knows the type typed, the payload is
+// deserialized into a typed sample first.
+class RawPublisher {
+ public:
+  RawPublisher(Context& ctx, const std::string& topic, const std::string& type_name, bool keyed, const QosPreset& qos);
+  ~RawPublisher();
+  RawPublisher(const RawPublisher&) = delete;
+  RawPublisher& operator=(const RawPublisher&) = delete;
+  // False when the payload does not decode as the participant's typed support, or DDS refuses it.
+  bool publish(const msg::RawSample& sample);
+  std::size_t matched() const { return base_.matched(); }
+
+ private:
+  std::shared_ptr<eprosima::fastdds::dds::TopicDataType> type_;
+  void* typed_ = nullptr;  // scratch sample when type_ is not raw
+  WriterBase base_;
+};
+
 // Receives any topic as serialized CDR, without knowing its type. A
 // participant has one type support per type name: when this one already
 // reads or writes the type typed (a component recording its own status), the
@@ -117,7 +141,7 @@ class RawSubscription {
   RawSubscription(Context& ctx, const std::string& topic, const std::string& type_name, bool keyed,
                   const QosPreset& qos, Callback cb)
       : cb_(std::move(cb)),
-        type_(registered_type(ctx, topic, type_name, keyed)),
+        type_(registered_raw_type(ctx, topic, type_name, keyed)),
         base_(ctx, topic, new msg::RawPubSubType(type_name, keyed), qos,
               [this](void* s, const SampleMeta& m) { deliver(s, m); }) {}
   std::size_t matched() const { return base_.matched(); }
@@ -126,8 +150,6 @@ class RawSubscription {
   }
 
  private:
-  static std::shared_ptr<eprosima::fastdds::dds::TopicDataType> registered_type(Context& ctx, const std::string& topic,
-                                                                                const std::string& type_name, bool keyed);
   void deliver(void* sample, const SampleMeta& m);
 
   Callback cb_;
