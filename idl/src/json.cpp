@@ -62,6 +62,12 @@ void to_json(nlohmann::json& j, const SyncControl& v) {
   j = {{"kind", to_string(v.kind())}, {"label", v.label()}, {"requester", v.requester()},
        {"request_id", v.request_id()}};
 }
+void to_json(nlohmann::json& j, const ClockOffset& v) {
+  j = {{"host", v.host().to_string()},   {"session_id", v.session_id()}, {"offset_ns", v.offset_ns()},
+       {"drift_ppm", v.drift_ppm()},     {"rtt_ns", v.rtt_ns()},         {"samples", v.samples()},
+       {"stamp_ns", v.stamp_ns()}};
+}
+
 void to_json(nlohmann::json& j, const SyncAck& v) {
   j = {{"component_name", v.component_name()}, {"host", v.host()},
        {"session_id", v.session_id()},         {"tick", v.tick()},

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <iomanip>
 #include <map>
+#include <memory>
 #include <set>
 
 #include <nlohmann/json.hpp>
@@ -15,6 +16,7 @@
 #include "skelgraph/runtime/registry.hpp"
 #include "skelgraph/mcap/mcap.hpp"
 #include "skelgraph/msg/cdr.hpp"
+#include "skelgraph/msg/json.hpp"
 #include "skelgraph/playback/readers.hpp"
 #include "skelgraph/recording/bag.hpp"
 #include "skelgraph/runtime/topics.hpp"
@@ -48,9 +50,16 @@ int info(const std::string& file, bool json) {
   // Ticks and sessions from the sync topic.
   std::uint64_t ticks = 0;
   std::set<std::uint32_t> sessions;
-  std::map<std::string, std::uint64_t> per_sensor;
+  std::map<std::string, std::uint64_t> per_sensor, acks_by_host;
+  std::map<std::string, nlohmann::json> clocks;
   reader.for_each_message([&](const mcap::Channel& ch, const mcap::Schema* schema, const mcap::Message& m) {
     if (schema == nullptr) return;
+    if (schema->name == msg::MessageTraits<msg::SyncAck>::name) {
+      ++acks_by_host[msg::from_cdr<msg::SyncAck>(m.data.data(), m.data.size()).host().to_string()];
+    } else if (schema->name == msg::MessageTraits<msg::ClockOffset>::name) {
+      const auto c = msg::from_cdr<msg::ClockOffset>(m.data.data(), m.data.size());
+      clocks[c.host().to_string()] = nlohmann::json(c);
+    }
     if (ch.topic == runtime::topics::kSync.name && schema->name == msg::MessageTraits<msg::SyncCommand>::name) {
       const auto c = msg::from_cdr<msg::SyncCommand>(m.data.data(), m.data.size());
       if (c.kind() == msg::SYNC_TICK) ++ticks;
@@ -87,6 +96,8 @@ int info(const std::string& file, bool json) {
                            {"sessions", sessions},
                            {"topics", topics},
                            {"skeletons_per_sensor", per_sensor},
+                           {"ticks_acked_by_host", acks_by_host},
+                           {"clock_offsets", clocks},
                            {"metadata", metadata}};
   if (json) {
     std::printf("%s\n", out.dump(2).c_str());
@@ -99,6 +110,11 @@ int info(const std::string& file, bool json) {
     for (const auto& t : topics) {
       std::printf("  %-32s %-34s %8llu msgs %8.2f Hz\n", t["topic"].get<std::string>().c_str(),
                   t["type"].get<std::string>().c_str(), t["count"].get<unsigned long long>(), t["rate_hz"].get<double>());
+    }
+    for (const auto& [h, n] : acks_by_host) std::printf("  host %-20s %8llu ticks acked\n", h.c_str(), static_cast<unsigned long long>(n));
+    for (const auto& [h, c] : clocks) {
+      std::printf("  clock %-19s offset %+.3f ms, drift %+.1f ppm, rtt %.3f ms\n", h.c_str(),
+                  c["offset_ns"].get<double>() * 1e-6, c["drift_ppm"].get<double>(), c["rtt_ns"].get<double>() * 1e-6);
     }
     for (const auto& [k, n] : per_sensor) std::printf("  skeletons %-40s %8llu\n", k.c_str(), static_cast<unsigned long long>(n));
     for (const auto& m : s.metadata) {
@@ -216,6 +232,93 @@ int recover(const std::string& in, const std::string& out, bool json) {
   return 0;
 }
 
+// Several hosts' recordings of one session onto the sync master's timeline:
+// each file's log times are corrected by its host's clock offset (the latest
+// skelgraph/sync/clock estimate found in any input, drift included); a message
+// recorded by several hosts (same topic, same bytes) is kept once; repeats
+// within one recording are kept.
+int merge(const std::vector<std::string>& files, const std::string& out_path, mcap::Compression compression, bool json) {
+  struct Input {
+    std::string file, host;
+  };
+  std::vector<Input> inputs;
+  std::map<std::string, msg::ClockOffset> clocks;  // latest per host
+  std::vector<std::unique_ptr<mcap::Reader>> readers;
+  for (const auto& f : files) {
+    readers.push_back(user_input([&] { return std::make_unique<mcap::Reader>(f); }));
+    const auto s = user_input([&] { return readers.back()->summary(); });
+    std::string host;
+    for (const auto& m : s.metadata) {
+      if (m.name == "session" && m.values.count("host")) host = m.values.at("host");
+    }
+    if (host.empty()) throw UsageError(f + ": no session metadata naming its host (not written by the recorder?)");
+    inputs.push_back({f, host});
+    readers.back()->for_each_message([&](const mcap::Channel& ch, const mcap::Schema*, const mcap::Message& m) {
+      if (ch.topic != runtime::topics::kSyncClock.name) return;
+      auto c = msg::from_cdr<msg::ClockOffset>(m.data.data(), m.data.size());
+      auto& slot = clocks[c.host().to_string()];
+      if (c.stamp_ns() >= slot.stamp_ns()) slot = c;
+    });
+  }
+  struct Item {
+    std::uint64_t time;
+    std::string topic, type;
+    bool keyed;
+    std::string data;
+    std::uint64_t publish_time;
+  };
+  std::vector<Item> items;
+  std::map<std::pair<std::string, std::string>, std::size_t> seen;  // (topic, bytes) -> the input that had it
+  std::uint64_t duplicates = 0;
+  nlohmann::json applied = nlohmann::json::object();
+  std::map<std::string, std::uint64_t> acks_by_host;
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    const auto it = clocks.find(inputs[i].host);
+    const double offset = it == clocks.end() ? 0.0 : static_cast<double>(it->second.offset_ns());
+    const double drift = it == clocks.end() ? 0.0 : it->second.drift_ppm() * 1e-6;
+    const double at = it == clocks.end() ? 0.0 : static_cast<double>(it->second.stamp_ns());
+    applied[inputs[i].file] = {{"host", inputs[i].host}, {"offset_ns", offset}, {"drift_ppm", drift * 1e6},
+                               {"estimated", it != clocks.end()}};
+    readers[i]->for_each_message([&](const mcap::Channel& ch, const mcap::Schema*, const mcap::Message& m) {
+      const std::string data(m.data);
+      const auto [where, fresh] = seen.emplace(std::make_pair(ch.topic, data), i);
+      if (!fresh && where->second != i) {  // another host recorded the same sample
+        ++duplicates;
+        return;
+      }
+      // Host clock -> master clock: subtract the offset the host had at that moment.
+      const double t = static_cast<double>(m.log_time);
+      const double corrected = t - (offset + drift * (t - at));
+      const auto type = ch.metadata.count("dds_type") ? ch.metadata.at("dds_type") : std::string();
+      const bool keyed = ch.metadata.count("keyed") && ch.metadata.at("keyed") == "true";
+      if (ch.topic == runtime::topics::kSyncAck.name) {
+        ++acks_by_host[msg::from_cdr<msg::SyncAck>(m.data.data(), m.data.size()).host().to_string()];
+      }
+      items.push_back({static_cast<std::uint64_t>(std::max(0.0, corrected)), ch.topic, type, keyed, data, m.publish_time});
+    });
+  }
+  std::stable_sort(items.begin(), items.end(), [](const Item& a, const Item& b) { return a.time < b.time; });
+  mcap::WriterOptions wo;
+  wo.compression = compression;
+  recording::BagWriter bag(out_path, wo);
+  mcap::KeyValues meta{{"inputs", std::to_string(files.size())}, {"duplicates_dropped", std::to_string(duplicates)}};
+  for (const auto& in : inputs) meta["host " + in.host] = in.file;
+  for (const auto& [host, c] : clocks) {
+    meta["offset_ns " + host] = std::to_string(c.offset_ns());
+    meta["drift_ppm " + host] = std::to_string(c.drift_ppm());
+  }
+  for (const auto& [host, n] : acks_by_host) meta["ticks_acked " + host] = std::to_string(n);
+  bag.write_metadata("merge", meta);
+  for (const auto& it : items) bag.write_cdr(it.topic, it.type, it.keyed, it.data, it.time, it.publish_time);
+  bag.close();
+  const nlohmann::json report{{"out", out_path},       {"messages", items.size()}, {"duplicates_dropped", duplicates},
+                              {"inputs", applied},     {"ticks_acked_by_host", acks_by_host}};
+  if (json) std::printf("%s\n", report.dump(2).c_str());
+  else std::printf("%s: %zu messages (%llu duplicates dropped) from %zu recordings\n", out_path.c_str(), items.size(),
+                   static_cast<unsigned long long>(duplicates), files.size());
+  return 0;
+}
+
 }  // namespace
 
 // Runs one component of `kind` with parameters given as text.
@@ -234,7 +337,7 @@ int run_component(GlobalOptions& g, const std::string& kind, const std::vector<r
 }
 
 void add_bag_command(CLI::App& app, GlobalOptions& g, Action& run) {
-  auto* bag = app.add_subcommand("bag", "MCAP recordings: record, play, info, import, export, recover");
+  auto* bag = app.add_subcommand("bag", "MCAP recordings: record, play, info, merge, import, export, recover");
   bag->require_subcommand(1);
   struct Opts {
     std::string file, out, format = "csv", compression = "zstd", on_error = "stop", sensor_id;
@@ -322,6 +425,15 @@ void add_bag_command(CLI::App& app, GlobalOptions& g, Action& run) {
   ex->add_option("--out", o->out, "output directory")->required();
   ex->add_flag("--json", o->json, "machine-readable summary");
   ex->callback([o, &run] { run = [o] { return export_bag(o->file, o->format, o->out, o->json); }; });
+
+  auto* mg = bag->add_subcommand("merge", "Several hosts' recordings of a session onto the sync master's timeline");
+  mg->add_option("files", o->files, "recordings (one per host)")->required()->check(CLI::ExistingFile);
+  mg->add_option("--out", o->out, "MCAP file to write")->required();
+  mg->add_option("--compression", o->compression, "chunk compression")->check(CLI::IsMember({"none", "lz4", "zstd"}));
+  mg->add_flag("--json", o->json, "machine-readable summary");
+  mg->callback([o, &run] {
+    run = [o] { return merge(o->files, o->out, *mcap::compression_from_name(o->compression), o->json); };
+  });
 
   auto* rc = bag->add_subcommand("recover", "Salvage every complete chunk of a recording whose writer was killed");
   rc->add_option("file", o->file, "damaged MCAP file")->required()->check(CLI::ExistingFile);

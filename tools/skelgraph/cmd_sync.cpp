@@ -50,9 +50,19 @@ int request(const runtime::DdsConfig& config, msg::SyncKind kind, const std::str
   c.label(label.substr(0, 128));
   c.requester(me.substr(0, 64));
   c.request_id(request_id.substr(0, 64));
-  control.publish(c);
+  // The control topic is volatile and other readers (a recorder) may have
+  // matched our writer before the master did, so the request is repeated every
+  // second until answered; the master handles each request id once.
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
   std::unique_lock<std::mutex> lock(mutex);
-  if (!cv.wait_for(lock, timeout, [&] { return answer.has_value(); })) {
+  while (!answer.has_value() && std::chrono::steady_clock::now() < deadline) {
+    lock.unlock();
+    control.publish(c);
+    lock.lock();
+    cv.wait_until(lock, std::min(deadline, std::chrono::steady_clock::now() + std::chrono::seconds(1)),
+                  [&] { return answer.has_value(); });
+  }
+  if (!answer.has_value()) {
     if (kind == msg::SYNC_STOP) {
       std::fprintf(stderr, "no session was running (the sync master did not answer the STOP within %.1f s)\n",
                    timeout_s);

@@ -14,6 +14,7 @@ runtime::ComponentInfo BagPlayer::describe() {
   info.params.add_string("file", "", "the recording (MCAP)")
       .add_double("rate", 1.0, "speed: 1 = as recorded, 2 = twice as fast", 0.01, 1000.0)
       .add_bool("loop", false, "start again at the end")
+      .add_double("wait_s", 2.0, "before playing, wait up to this long for every topic to have a reader", 0.0, 60.0)
       .add_string_list("topics", {}, "only these topics (default: all but skelgraph/status)");
   return info;
 }
@@ -22,7 +23,8 @@ BagPlayer::BagPlayer(runtime::Context& ctx, const runtime::Params& params)
     : Component(ctx),
       file_(params.get<std::string>("file")),
       rate_(params.get<double>("rate")),
-      loop_(params.get<bool>("loop")) {
+      loop_(params.get<bool>("loop")),
+      wait_ns_(static_cast<std::int64_t>(params.get<double>("wait_s") * 1e9)) {
   if (file_.empty()) throw std::invalid_argument("parameter 'file' names no recording");
   const auto wanted = params.get<std::vector<std::string>>("topics");
   const mcap::Reader reader(file_);  // McapError names what is wrong and where
@@ -61,6 +63,13 @@ void BagPlayer::on_start() {
 }
 
 void BagPlayer::tick() {
+  if (!playing_) {
+    // Best-effort samples written before discovery matched a reader are lost: wait for readers first.
+    const bool all_matched = std::all_of(publishers_.begin(), publishers_.end(), [](const auto& p) { return p->matched() > 0; });
+    if (!all_matched && runtime::Context::monotonic_ns() - start_mono_ns_ < wait_ns_) return;
+    playing_ = true;
+    start_mono_ns_ = runtime::Context::monotonic_ns();
+  }
   const auto first = items_.front().log_time;
   const double elapsed = static_cast<double>(runtime::Context::monotonic_ns() - start_mono_ns_) * rate_;
   while (next_ < items_.size() && static_cast<double>(items_[next_].log_time - first) <= elapsed) {

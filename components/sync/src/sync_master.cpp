@@ -45,7 +45,30 @@ SyncMaster::SyncMaster(runtime::Context& ctx, const runtime::Params& params)
       sync_pub_(ctx, runtime::topics::kSync),
       session_pub_(ctx, runtime::topics::kSyncSession),
       control_sub_(ctx, runtime::topics::kSyncControl,
-                   [this](const msg::SyncControl& c, const runtime::SampleMeta&) { on_control(c); }) {}
+                   [this](const msg::SyncControl& c, const runtime::SampleMeta&) { on_control(c); }),
+      ack_sub_(ctx, runtime::topics::kSyncAck, [this](const msg::SyncAck& a, const runtime::SampleMeta& m) { on_ack(a, m); }),
+      clock_pub_(ctx, runtime::topics::kSyncClock) {}
+
+void SyncMaster::on_ack(const msg::SyncAck& a, const runtime::SampleMeta& m) {
+  const auto host = a.host().size() > 0 ? a.host().to_string() : a.component_name().to_string();
+  auto& clock = clocks_[host];
+  // t4: when the ack reached us, on our clock (taken on the executor: includes its queueing, which the
+  // round-trip filter tolerates).
+  if (!clock.estimator.add({a.master_stamp_ns(), a.receive_stamp_ns(), a.send_stamp_ns(), m.receive_ns})) return;
+  if (m.receive_ns - clock.published_ns < 1'000'000'000) return;
+  clock.last = clock.estimator.estimate();
+  if (!clock.last) return;
+  msg::ClockOffset c;
+  c.host(host.substr(0, 64));
+  c.session_id(a.session_id());
+  c.offset_ns(clock.last->offset_ns);
+  c.drift_ppm(clock.last->drift_ppm);
+  c.rtt_ns(clock.last->rtt_ns);
+  c.samples(static_cast<std::uint32_t>(clock.last->samples));
+  c.stamp_ns(m.receive_ns);
+  clock_pub_.publish(c);
+  clock.published_ns = m.receive_ns;
+}
 
 std::int64_t SyncMaster::mono_ns() { return runtime::Context::monotonic_ns(); }
 
@@ -68,6 +91,10 @@ void SyncMaster::on_shutdown() {
 }
 
 void SyncMaster::on_control(const msg::SyncControl& c) {
+  // Requesters repeat a request until answered: each request id is handled once.
+  const auto id = c.request_id().to_string();
+  if (!id.empty() && id == last_request_id_) return;
+  last_request_id_ = id;
   if (c.kind() == msg::SYNC_START) {
     const auto label = c.label().size() == 0 ? label_ : c.label().to_string();
     spdlog::info("{}: START '{}' requested by {}", ctx_.name(), label, c.requester().to_string());
@@ -94,9 +121,16 @@ void SyncMaster::publish(const std::vector<SyncEvent>& events) {
 }
 
 nlohmann::json SyncMaster::details() const {
+  nlohmann::json clocks = nlohmann::json::object();
+  for (const auto& [host, c] : clocks_) {
+    if (!c.last) continue;
+    clocks[host] = {{"offset_ns", c.last->offset_ns}, {"drift_ppm", c.last->drift_ppm},
+                    {"rtt_ns", c.last->rtt_ns},       {"samples", c.last->samples}};
+  }
   return {{"sessions_started", core_.sessions_started()}, {"session_id", core_.session_id()},
           {"label", core_.label()},                       {"running", core_.running()},
-          {"ticks_sent", core_.ticks_sent()},             {"ticks_skipped", core_.ticks_skipped()}};
+          {"ticks_sent", core_.ticks_sent()},             {"ticks_skipped", core_.ticks_skipped()},
+          {"clocks", clocks}};
 }
 
 std::string SyncMaster::summary() const {

@@ -33,6 +33,8 @@ class BagPlayer final : public runtime::Component {
   std::string file_;
   double rate_;
   bool loop_;
+  std::int64_t wait_ns_;
+  bool playing_ = false;
   std::vector<std::unique_ptr<runtime::RawPublisher>> publishers_;
   std::vector<std::string> publisher_topics_;
   std::vector<Item> items_;  // in log-time order

@@ -63,7 +63,8 @@ class Context {
   Executor& executor() { return executor_; }
   eprosima::fastdds::dds::DomainParticipant& participant() { return *participant_; }
 
-  // Wall-clock time in ns since the Unix epoch: message stamps.
+  // Wall-clock time in ns since the Unix epoch: message stamps (plus
+  // SKELGRAPH_CLOCK_SKEW_NS when set: a test hook to play a host with another clock).
   static std::int64_t now_ns();
   // Monotonic time in ns (arbitrary origin): pacing and intervals.
   static std::int64_t monotonic_ns();

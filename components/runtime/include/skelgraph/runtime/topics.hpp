@@ -37,6 +37,8 @@ inline const TopicDef<msg::SyncCommand> kSyncSession{"skelgraph/sync/session", {
 // Requests to the sync master (skelgraph sync start|stop, robots).
 inline const TopicDef<msg::SyncControl> kSyncControl{"skelgraph/sync/control", {R::Reliable, D::Volatile, 0}};
 inline const TopicDef<msg::SyncAck> kSyncAck{"skelgraph/sync_ack", {R::Reliable, D::Volatile, 0}};
+// Each host's clock offset, from the sync master; late joiners (recorders) get the latest per host.
+inline const TopicDef<msg::ClockOffset> kSyncClock{"skelgraph/sync/clock", {R::Reliable, D::TransientLocal, 32}};
 inline const TopicDef<msg::Skeleton> kSkeletonRaw{"skelgraph/skeleton/raw", {R::BestEffort, D::Volatile, 5}};
 inline const TopicDef<msg::Skeleton> kSkeletonFused{"skelgraph/skeleton/fused", {R::BestEffort, D::Volatile, 5}};
 inline const TopicDef<msg::Skeleton> kSkeletonTruth{"skelgraph/skeleton/truth", {R::Reliable, D::Volatile, 64}};
