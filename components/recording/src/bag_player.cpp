@@ -65,8 +65,12 @@ void BagPlayer::on_start() {
 void BagPlayer::tick() {
   if (!playing_) {
     // Best-effort samples written before discovery matched a reader are lost: wait for readers first.
+    // A writer matches a reader before that reader has matched the writer; give the other side 0.5 s more.
+    const auto now = runtime::Context::monotonic_ns();
     const bool all_matched = std::all_of(publishers_.begin(), publishers_.end(), [](const auto& p) { return p->matched() > 0; });
-    if (!all_matched && runtime::Context::monotonic_ns() - start_mono_ns_ < wait_ns_) return;
+    if (all_matched && matched_at_ == 0) matched_at_ = now;
+    const bool settled = matched_at_ != 0 && now - matched_at_ >= 500'000'000;
+    if (!settled && now - start_mono_ns_ < wait_ns_) return;
     playing_ = true;
     start_mono_ns_ = runtime::Context::monotonic_ns();
   }

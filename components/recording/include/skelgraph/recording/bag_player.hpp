@@ -35,6 +35,7 @@ class BagPlayer final : public runtime::Component {
   bool loop_;
   std::int64_t wait_ns_;
   bool playing_ = false;
+  std::int64_t matched_at_ = 0;
   std::vector<std::unique_ptr<runtime::RawPublisher>> publishers_;
   std::vector<std::string> publisher_topics_;
   std::vector<Item> items_;  // in log-time order
