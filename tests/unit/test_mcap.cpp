@@ -2,6 +2,7 @@
 // truncated files (clear errors, never a crash), recovery of a killed writer.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -197,4 +198,23 @@ TEST(Mcap, WriterRefusesWhatItCannotDo) {
   EXPECT_THROW(w.add_channel(9, "t", "cdr"), McapError);     // no such schema
   EXPECT_EQ(compression_from_name("zstd"), Compression::Zstd);
   EXPECT_FALSE(compression_from_name("gzip").has_value());
+}
+
+// Inputs the fuzzer found interesting or crashing (tests/fuzz/regressions): each reads or fails cleanly.
+TEST(Mcap, FuzzRegressionInputsNeverCrash) {
+  const char* src = std::getenv("SKELGRAPH_SOURCE_DIR");
+  const auto dir = std::filesystem::path(src ? src : ".") / "tests" / "fuzz" / "regressions";
+  ASSERT_TRUE(std::filesystem::is_directory(dir)) << dir;
+  int files = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    if (e.path().filename() == ".keep") continue;
+    ++files;
+    const Reader r(slurp(e.path().string()), e.path().filename().string());
+    try {
+      r.validate();
+      r.for_each_message([](const Channel&, const Schema*, const Message&) {});
+    } catch (const McapError&) {
+    }
+  }
+  EXPECT_GE(files, 1);
 }
