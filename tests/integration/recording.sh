@@ -58,10 +58,10 @@ ok "two hosts: every tick acked by both, offset of hostB found, merged onto one 
 # A recording replayed and recorded again: the same count on every topic.
 a_file=$(ls "$WORK/rec"/two_hosts_*_hostA.mcap)
 kill -INT "$sim"; wait "$sim" || true
-"$SKELGRAPH" bag record --now --label replay --dir "$WORK/replay" --duration 20 >/dev/null 2>"$WORK/r.err" &
+"$SKELGRAPH" bag record --now --label replay --dir "$WORK/replay" --duration 40 >/dev/null 2>"$WORK/r.err" &
 rec=$!
 sleep 2
-"$SKELGRAPH" bag play "$a_file" --duration 10 --json >"$WORK/play.json" 2>"$WORK/play.err" || fail "play: $(cat "$WORK/play.err")"
+"$SKELGRAPH" bag play "$a_file" --duration 20 --json >"$WORK/play.json" 2>"$WORK/play.err" || fail "play: $(cat "$WORK/play.err")"
 sleep 1
 kill -INT "$rec"; wait "$rec" || fail "re-record: $(cat "$WORK/r.err")"
 "$SKELGRAPH" bag info "$a_file" --json >"$WORK/orig.json"
@@ -71,12 +71,19 @@ import json, sys
 orig, again, play = (json.load(open(p)) for p in sys.argv[1:4])
 count = lambda d: {t["topic"]: t["count"] for t in d["topics"]}
 o, a = count(orig), count(again)
-published = play["components"][0]["details"]["published"]
-for topic in ("skelgraph/skeleton/raw", "skelgraph/skeleton/truth", "skelgraph/sync", "skelgraph/sync/clock"):
+details = play["components"][0]["details"]
+published = details["published"]
+assert details["passes"] == 1 and published == details["messages"], details   # the player got to the end
+# Reliable topics: every message, exactly. skeleton/raw is best-effort by design
+# (a late sample is worthless to fusion), so a loaded machine may drop some:
+# most must arrive, and the loss is reported.
+for topic in ("skelgraph/skeleton/truth", "skelgraph/sync", "skelgraph/sync/clock"):
     assert o[topic] == a[topic], (topic, o[topic], a[topic])
-print("replayed %d messages; raw %d, truth %d, sync %d recorded again" % (published, a["skelgraph/skeleton/raw"], a["skelgraph/skeleton/truth"], a["skelgraph/sync"]))
+raw_o, raw_a = o["skelgraph/skeleton/raw"], a["skelgraph/skeleton/raw"]
+assert 0.85 * raw_o <= raw_a <= raw_o, (raw_o, raw_a)
+print("replayed %d messages; truth %d, sync %d identical; best-effort raw %d of %d" % (published, a["skelgraph/skeleton/truth"], a["skelgraph/sync"], raw_a, raw_o))
 PY
-ok "replay re-recorded with identical counts"
+ok "replay re-recorded: reliable topics identical"
 
 # SIGKILL: at most about a second lost, everything before it recovered.
 "$SKELGRAPH" launch "$SRC/bringup/sim_dual.yaml" --duration 30 >/dev/null 2>&1 &
@@ -106,4 +113,12 @@ assert raw > 150, raw
 print("recovered %d messages; the last %.2f s before the kill lost" % (info["messages"], lost))
 PY
 ok "SIGKILLed recorder recovered: $(python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); print(d["messages"], "messages")' "$WORK/fixed.json")"
+# An unwritable directory: the reason on the status, exit 1, no crash.
+set +e
+"$SKELGRAPH" bag record --now --dir /proc/skelgraph-cannot-write --duration 1 --json >"$WORK/unwritable.json" 2>/dev/null
+rc=$?
+set -e
+[ "$rc" -eq 1 ] || fail "unwritable directory: exit $rc, expected 1"
+json_check "$WORK/unwritable.json" '"cannot create recording directory /proc/skelgraph-cannot-write" in d["components"][0]["details"]["error"]'
+ok "unwritable directory: $(json_get "$WORK/unwritable.json" 'd["components"][0]["details"]["error"]')"
 echo "recording: all checks passed"

@@ -534,6 +534,36 @@ Channel parse_channel(In& r) {
   return c;
 }
 
+Message parse_message(In& r) {
+  Message m;
+  m.channel_id = r.u16("message channel");
+  m.sequence = r.u32("message sequence");
+  m.log_time = r.u64("message log time");
+  m.publish_time = r.u64("message publish time");
+  m.data = r.rest();
+  return m;
+}
+
+Metadata parse_metadata(In& r) {
+  Metadata m;
+  m.name = r.str("metadata name");
+  m.values = r.map_ss("metadata");
+  return m;
+}
+
+// A chunk record's records, decompressed and CRC-checked (`at`: the record's offset).
+std::string read_chunk(In& r, std::uint64_t at, const std::string& name) {
+  r.u64("chunk start time");
+  r.u64("chunk end time");
+  const auto size = r.u64("chunk uncompressed size");
+  const auto crc = r.u32("chunk crc");
+  const auto compression = r.str("chunk compression");
+  const auto packed = r.take(r.u64("chunk records length"), "chunk records");
+  std::string raw = decompress(compression, packed, size, at, name);
+  if (crc != 0 && crc != crc32_of(raw)) throw McapError(name + ": chunk CRC mismatch", at);
+  return raw;
+}
+
 }  // namespace
 
 void Reader::scan(Scan& s, bool strict) const {
@@ -568,12 +598,7 @@ void Reader::scan(Scan& s, bool strict) const {
       }
       s.summary.channels[c.id] = std::move(c);
     } else if (iop == kMessage) {
-      Message m;
-      m.channel_id = r.u16("message channel");
-      m.sequence = r.u32("message sequence");
-      m.log_time = r.u64("message log time");
-      m.publish_time = r.u64("message publish time");
-      m.data = r.rest();
+      const Message m = parse_message(r);
       const auto ch = s.summary.channels.find(m.channel_id);
       if (ch == s.summary.channels.end()) {
         throw McapError(name_ + ": message on channel " + std::to_string(m.channel_id) + " before the channel is defined", rat);
@@ -603,14 +628,7 @@ void Reader::scan(Scan& s, bool strict) const {
     }
     if (op == kHeader || op == kFooter) throw McapError(name_ + ": unexpected record 0x0" + std::to_string(op) + " in the data section", at);
     if (op == kChunk) {
-      r.u64("chunk start time");
-      r.u64("chunk end time");
-      const auto size = r.u64("chunk uncompressed size");
-      const auto crc = r.u32("chunk crc");
-      const auto compression = r.str("chunk compression");
-      const auto packed = r.take(r.u64("chunk records length"), "chunk records");
-      const std::string raw = decompress(compression, packed, size, at, name_);
-      if (crc != 0 && crc != crc32_of(raw)) throw McapError(name_ + ": chunk CRC mismatch", at);
+      const std::string raw = read_chunk(r, at, name_);
       In inner(raw, 0, name_);
       while (!inner.done()) {
         const auto iat = inner.offset();
@@ -625,10 +643,7 @@ void Reader::scan(Scan& s, bool strict) const {
       s.chunk_records.emplace_back(at, file.offset() - at);
       ++s.chunks;
     } else if (op == kMetadata) {
-      Metadata m;
-      m.name = r.str("metadata name");
-      m.values = r.map_ss("metadata");
-      s.summary.metadata.push_back(std::move(m));
+      s.summary.metadata.push_back(parse_metadata(r));
     } else {
       handle_inner(op, r, at);
     }
@@ -722,20 +737,12 @@ RecoveryReport recover(const std::string& in_path, const std::string& out_path, 
       const auto sid = c.schema_id == 0 ? 0 : schema_ids.at(c.schema_id);
       channel_ids[c.id] = w.add_channel(sid, c.topic, c.message_encoding, c.metadata);
     } else if (op == kMessage) {
-      Message m;
-      m.channel_id = r.u16("message channel");
-      m.sequence = r.u32("message sequence");
-      m.log_time = r.u64("message log time");
-      m.publish_time = r.u64("message publish time");
-      m.data = r.rest();
+      Message m = parse_message(r);
       m.channel_id = channel_ids.at(m.channel_id);
       w.write(m);
       ++rep.messages;
     } else if (op == kMetadata) {
-      Metadata m;
-      m.name = r.str("metadata name");
-      m.values = r.map_ss("metadata");
-      w.write_metadata(m);
+      w.write_metadata(parse_metadata(r));
     }
   };
   In file(std::string_view(bytes).substr(kMagicSize), kMagicSize, in_path);
@@ -748,13 +755,7 @@ RecoveryReport recover(const std::string& in_path, const std::string& out_path, 
       In r(file.take(len, "record"), file.offset() - len, in_path);
       if (op == kDataEnd) break;
       if (op == kChunk) {
-        r.u64("chunk start time");
-        r.u64("chunk end time");
-        const auto size = r.u64("chunk uncompressed size");
-        const auto crc = r.u32("chunk crc");
-        const auto compression = r.str("chunk compression");
-        const std::string raw = decompress(compression, r.take(r.u64("chunk records length"), "chunk records"), size, at, in_path);
-        if (crc != 0 && crc != crc32_of(raw)) throw McapError(in_path + ": chunk CRC mismatch", at);
+        const std::string raw = read_chunk(r, at, in_path);
         // Parse the whole chunk before taking any of it: a chunk is kept whole or not at all.
         std::vector<std::pair<std::uint8_t, std::string_view>> records;
         In inner(raw, 0, in_path);
