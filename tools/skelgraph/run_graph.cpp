@@ -63,7 +63,9 @@ int run_graph(const runtime::ComponentRegistry& registry, const runtime::DdsConf
   print_reports(graph, "stop");
   nlohmann::json report;
   report["components"] = nlohmann::json::array();
+  bool failed = false;
   for (const auto& r : graph.report()) {
+    failed = failed || r.state == "ERROR";
     report["components"].push_back(
         {{"name", r.name}, {"kind", r.kind}, {"state", r.state}, {"message", r.message}, {"summary", r.summary}, {"io", r.io},
          {"details", r.details}});
@@ -73,7 +75,7 @@ int run_graph(const runtime::ComponentRegistry& registry, const runtime::DdsConf
   report["profile"] = config.profile;
   if (extra_report) extra_report(graph, report);
   if (options.json) std::printf("%s\n", report.dump(2).c_str());
-  return 0;
+  return failed ? 1 : 0;  // a component that ended in ERROR (the report says why)
 }
 
 }  // namespace skelgraph::cli
