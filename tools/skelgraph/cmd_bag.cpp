@@ -19,6 +19,7 @@
 #include "skelgraph/msg/json.hpp"
 #include "skelgraph/playback/readers.hpp"
 #include "skelgraph/recording/bag.hpp"
+#include "skelgraph/recording/session_recorder.hpp"
 #include "skelgraph/runtime/topics.hpp"
 #include "skelgraph/skeleton/skeleton_msg.hpp"
 
@@ -152,13 +153,6 @@ int import(playback::Format format, const std::vector<std::string>& files, const
   return 0;
 }
 
-std::string file_safe(std::string s) {
-  for (auto& c : s) {
-    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_' && c != '.') c = '_';
-  }
-  return s;
-}
-
 // generic: our lossless CSV (reads back with the generic reader). csv: plain
 // numeric columns per sensor, one line per frame, as the thesis's per-Kinect
 // text logs were: time, person, then x, y, z, confidence of every joint.
@@ -170,7 +164,7 @@ int export_bag(const std::string& file, const std::string& format, const std::st
       if (schema == nullptr || schema->name != msg::MessageTraits<msg::Skeleton>::name) return;
       auto s = skeleton::from_msg(msg::from_cdr<msg::Skeleton>(m.data.data(), m.data.size()));
       const auto tail = ch.topic.substr(ch.topic.rfind('/') + 1);
-      auto& rec = by_stream[file_safe(tail + "_" + s.sensor_id)];
+      auto& rec = by_stream[recording::file_safe(tail + "_" + s.sensor_id)];
       rec.format = "generic";
       rec.metadata["topic"] = ch.topic;
       rec.metadata["source"] = file;

@@ -212,6 +212,25 @@ std::optional<Compression> compression_from_name(std::string_view n) {
   return std::nullopt;
 }
 
+std::string schema_body(const Schema& sc) {
+  Out o;
+  o.u16(sc.id);
+  o.str(sc.name);
+  o.str(sc.encoding);
+  o.str(sc.data);
+  return o.s;
+}
+
+std::string channel_body(const Channel& c) {
+  Out o;
+  o.u16(c.id);
+  o.u16(c.schema_id);
+  o.str(c.topic);
+  o.str(c.message_encoding);
+  o.map_ss(c.metadata);
+  return o.s;
+}
+
 // ---------------------------------------------------------------- writer
 
 struct Writer::ChunkIndex {
@@ -264,12 +283,7 @@ std::uint16_t Writer::add_schema(const std::string& name, const std::string& enc
   }
   if (schemas_.size() >= 65535) throw McapError(path_ + ": too many schemas");
   Schema s{static_cast<std::uint16_t>(schemas_.size() + 1), name, encoding, data};
-  Out o;
-  o.u16(s.id);
-  o.str(s.name);
-  o.str(s.encoding);
-  o.str(s.data);
-  chunk_ += record(kSchema, o.s);
+  chunk_ += record(kSchema, schema_body(s));
   schemas_.push_back(std::move(s));
   return schemas_.back().id;
 }
@@ -282,13 +296,7 @@ std::uint16_t Writer::add_channel(std::uint16_t schema_id, const std::string& to
   }
   if (channels_.size() >= 65535) throw McapError(path_ + ": too many channels");
   Channel c{static_cast<std::uint16_t>(channels_.size() + 1), schema_id, topic, encoding, metadata};
-  Out o;
-  o.u16(c.id);
-  o.u16(c.schema_id);
-  o.str(c.topic);
-  o.str(c.message_encoding);
-  o.map_ss(c.metadata);
-  chunk_ += record(kChannel, o.s);
+  chunk_ += record(kChannel, channel_body(c));
   channels_.push_back(std::move(c));
   return channels_.back().id;
 }
@@ -397,25 +405,10 @@ void Writer::close() {
     groups.emplace_back(op, start, summary_start + summary.size() - start);
   };
   std::vector<std::string> bodies;
-  for (const auto& s : schemas_) {
-    Out o;
-    o.u16(s.id);
-    o.str(s.name);
-    o.str(s.encoding);
-    o.str(s.data);
-    bodies.push_back(o.s);
-  }
+  for (const auto& s : schemas_) bodies.push_back(schema_body(s));
   group(kSchema, bodies);
   bodies.clear();
-  for (const auto& c : channels_) {
-    Out o;
-    o.u16(c.id);
-    o.u16(c.schema_id);
-    o.str(c.topic);
-    o.str(c.message_encoding);
-    o.map_ss(c.metadata);
-    bodies.push_back(o.s);
-  }
+  for (const auto& c : channels_) bodies.push_back(channel_body(c));
   group(kChannel, bodies);
   bodies.clear();
   {

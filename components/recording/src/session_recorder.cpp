@@ -5,17 +5,15 @@
 
 namespace skelgraph::recording {
 
-namespace {
-std::string safe(std::string s) {
+std::string file_safe(std::string s) {
   for (auto& c : s) {
     if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_' && c != '.') c = '_';
   }
   return s.empty() ? "_" : s;
 }
-}  // namespace
 
 std::string SessionRecorder::file_name(const std::string& label, std::uint32_t session_id, const std::string& host) {
-  return safe(label) + "_" + std::to_string(session_id) + "_" + safe(host) + ".mcap";
+  return file_safe(label) + "_" + std::to_string(session_id) + "_" + file_safe(host) + ".mcap";
 }
 
 SessionRecorder::SessionRecorder(const RecorderOptions& options, const std::string& label, std::uint32_t session_id,

@@ -15,6 +15,9 @@
 
 namespace skelgraph::recording {
 
+// `s` with anything but [A-Za-z0-9._-] replaced by '_' (file names from labels, hosts, sensor ids).
+std::string file_safe(std::string s);
+
 struct RecorderOptions {
   std::string directory = "recordings";
   std::string host;                                   // goes into the file name and metadata
