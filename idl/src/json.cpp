@@ -67,6 +67,16 @@ void to_json(nlohmann::json& j, const ClockOffset& v) {
        {"drift_ppm", v.drift_ppm()},     {"rtt_ns", v.rtt_ns()},         {"samples", v.samples()},
        {"stamp_ns", v.stamp_ns()}};
 }
+void to_json(nlohmann::json& j, const FrameRef& v) {
+  j = {{"topic", v.topic().to_string()},   {"host", v.host().to_string()},
+       {"sensor_id", v.sensor_id().to_string()}, {"person_id", v.person_id()},
+       {"frame_number", v.frame_number()}, {"stamp_ns", v.stamp_ns()},
+       {"log_time_ns", v.log_time_ns()}};
+}
+void to_json(nlohmann::json& j, const TickFrames& v) {
+  j = {{"session_id", v.session_id()}, {"tick", v.tick()}, {"master_stamp_ns", v.master_stamp_ns()},
+       {"frames", v.frames()}};
+}
 
 void to_json(nlohmann::json& j, const SyncAck& v) {
   j = {{"component_name", v.component_name()}, {"host", v.host()},

@@ -51,7 +51,13 @@ assert abs(off["hostB"] - 250e6) < 2e6 and abs(off["hostA"]) < 2e6, off         
 assert merge["duplicates_dropped"] > 100, merge                                     # both recorded the same samples
 per = info["skeletons_per_sensor"]
 assert per["skelgraph/skeleton/raw sensor1"] > 150 and per["skelgraph/skeleton/raw sensor2"] > 150, per
-print("ticks %d acked by both hosts; offsets %s" % (ticks, {h: "%.3f ms" % (o / 1e6) for h, o in off.items()}))
+# Frames associated by tick: a record per tick, each sensor's frame at most ticks.
+assert merge["tick_records"] == ticks and info["tick_records"] == ticks, (merge["tick_records"], info["tick_records"], ticks)
+at = info["ticks_with_frames_of"]
+for s in ("sensor1", "sensor2"):
+    assert at.get("skelgraph/skeleton/raw " + s, 0) >= 0.5 * ticks, at
+assert any(k.startswith("skelgraph/skeleton/truth") and v >= 0.9 * ticks for k, v in at.items()), at   # truth never stops
+print("ticks %d acked by both hosts; offsets %s; frames at ticks %s" % (ticks, {h: "%.3f ms" % (o / 1e6) for h, o in off.items()}, at))
 PY
 ok "two hosts: every tick acked by both, offset of hostB found, merged onto one timeline"
 
@@ -86,7 +92,7 @@ PY
 ok "replay re-recorded: reliable topics identical"
 
 # SIGKILL: at most about a second lost, everything before it recovered.
-"$SKELGRAPH" launch "$SRC/bringup/sim_dual.yaml" --duration 30 >/dev/null 2>&1 &
+"$SKELGRAPH" launch "$SRC/bringup/sim_dual.yaml" --duration 40 >/dev/null 2>&1 &
 sim=$!
 "$SKELGRAPH" bag record --now --label killed --dir "$WORK/kill" --compression lz4 >/dev/null 2>"$WORK/k.err" &
 rec=$!
@@ -94,6 +100,41 @@ sleep 5
 kill -9 "$rec"
 killed_ns=$(python3 -c 'import time; print(time.time_ns())')
 wait "$rec" 2>/dev/null || true
+
+# A full disk (a small tmpfs in a private mount namespace): already full at
+# START, the reason is on the status and the exit code is 1; filling up while
+# recording, the same, and what was flushed before is recoverable.
+mkdir -p "$WORK/full"
+unshare -m -- bash -s "$SKELGRAPH" "$WORK" <<'FULL' || fail "full disk: $(cat "$WORK"/full_*.err 2>/dev/null | tail -5)"
+set -euo pipefail
+sg=$1 work=$2 disk=$2/full
+mount -t tmpfs -o size=64k tmpfs "$disk"
+dd if=/dev/zero of="$disk/fill" bs=4k 2>/dev/null || true
+set +e
+"$sg" bag record --now --dir "$disk/rec" --duration 1 --json >"$work/full_start.json" 2>"$work/full_start.err"; rc=$?
+set -e
+[ "$rc" -eq 1 ] || { echo "full at START: exit $rc, expected 1" >&2; exit 1; }
+umount "$disk"
+mount -t tmpfs -o size=200k tmpfs "$disk"   # one or two one-second chunks fit
+set +e
+"$sg" bag record --now --dir "$disk/rec" --compression none --duration 6 --json >"$work/full_run.json" 2>"$work/full_run.err"; rc=$?
+set -e
+[ "$rc" -eq 1 ] || { echo "filling up: exit $rc, expected 1" >&2; exit 1; }
+"$sg" bag recover "$disk"/rec/*.mcap --out "$work/full_fixed.mcap" --json >"$work/full_recover.json"
+umount "$disk"
+FULL
+python3 - "$WORK/full_start.json" "$WORK/full_run.json" "$WORK/full_recover.json" <<'PY' || fail "full disk: $(cat "$WORK/full_run.json")"
+import json, sys
+start, run, rec = (json.load(open(p)) for p in sys.argv[1:4])
+for d in (start, run):
+    c = d["components"][0]
+    assert c["state"] == "ERROR" and "No space left on device" in c["message"], c["message"]
+assert "cannot record session" in start["components"][0]["message"], start["components"][0]["message"]
+assert "recording stopped" in run["components"][0]["message"] and "bag recover" in run["components"][0]["message"]
+assert rec["messages"] > 0, rec
+print("full at START: %s\nfull while recording: %s; %d messages recovered" % (start["components"][0]["message"], run["components"][0]["message"], rec["messages"]))
+PY
+ok "full disk: a clear error on the status at START and while recording, no crash, flushed data recoverable"
 kill -INT "$sim"; wait "$sim" || true
 broken=$(ls "$WORK/kill"/killed_*.mcap)
 set +e

@@ -4,11 +4,13 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <map>
 
 #include "skelgraph/mcap/mcap.hpp"
 #include "skelgraph/msg/cdr.hpp"
 #include "skelgraph/playback/readers.hpp"
 #include "skelgraph/recording/bag.hpp"
+#include "skelgraph/recording/tick_frames.hpp"
 #include "skelgraph/skeleton/skeleton_msg.hpp"
 
 using namespace skelgraph;
@@ -88,4 +90,47 @@ TEST(Bag, ForeignTypesAreRecordedWithoutASchema) {
   EXPECT_EQ(s.channels.begin()->second.schema_id, 0);
   EXPECT_EQ(s.channels.begin()->second.metadata.at("dds_type"), "sensor_msgs::msg::dds_::JointState_");
   EXPECT_THROW(msg::from_cdr<msg::Skeleton>("\0\1\0\0ab", 6), std::runtime_error);
+}
+
+namespace {
+skelgraph::msg::FrameRef frame_ref(const std::string& sensor, std::uint32_t person, std::uint64_t n, std::int64_t t) {
+  skelgraph::msg::FrameRef f;
+  f.topic("skelgraph/skeleton/raw");
+  f.host("h");
+  f.sensor_id(sensor);
+  f.person_id(person);
+  f.frame_number(n);
+  f.log_time_ns(t);
+  return f;
+}
+}  // namespace
+
+TEST(TickFrames, EachTickGetsTheLatestRecentFrameOfEveryStream) {
+  skelgraph::recording::TickAssociator a(100'000'000);
+  a.frame(frame_ref("s1", 1, 10, 1'000'000'000));
+  a.frame(frame_ref("s1", 1, 11, 1'030'000'000));  // replaces frame 10
+  a.frame(frame_ref("s2", 1, 7, 1'020'000'000));
+  a.frame(frame_ref("s2", 2, 3, 1'025'000'000));   // another person: its own stream
+  auto t = a.tick(5, 1, 1'033'000'000, 1'033'000'000);
+  EXPECT_EQ(t.session_id(), 5u);
+  EXPECT_EQ(t.tick(), 1u);
+  ASSERT_EQ(t.frames().size(), 3u);
+  std::map<std::pair<std::string, std::uint32_t>, std::uint64_t> got;
+  for (const auto& f : t.frames()) got[{f.sensor_id().to_string(), f.person_id()}] = f.frame_number();
+  EXPECT_EQ(got.at({"s1", 1}), 11u);
+  EXPECT_EQ(got.at({"s2", 1}), 7u);
+  EXPECT_EQ(got.at({"s2", 2}), 3u);
+  // s2 falls silent: 100 ms after its last frame it is no longer attached to ticks.
+  a.frame(frame_ref("s1", 1, 12, 1'063'000'000));
+  t = a.tick(5, 2, 1'066'000'000, 1'066'000'000);
+  EXPECT_EQ(t.frames().size(), 3u);
+  a.frame(frame_ref("s1", 1, 13, 1'120'000'000));
+  t = a.tick(5, 3, 1'130'000'000, 1'130'000'000);
+  ASSERT_EQ(t.frames().size(), 1u);
+  EXPECT_EQ(t.frames()[0].frame_number(), 13u);
+  // A frame received after the tick belongs to the next one, not this.
+  t = a.tick(5, 4, 1'160'000'000, 1'160'000'000);
+  a.frame(frame_ref("s1", 1, 14, 1'161'000'000));
+  ASSERT_EQ(t.frames().size(), 1u);
+  EXPECT_EQ(t.frames()[0].frame_number(), 13u);
 }

@@ -4,6 +4,8 @@
 #include <set>
 #include <condition_variable>
 #include <mutex>
+#include <stdexcept>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -105,4 +107,30 @@ TEST(Executor, StopRunsQueuedWorkThenTheLastTaskAndDropsLaterPosts) {
   EXPECT_EQ(seen, (std::vector<int>{1, 2}));
   EXPECT_FALSE(ex.run_sync([] {}, 10ms));
   ex.stop();  // idempotent
+}
+
+TEST(Executor, AnExceptionInATaskOrTimerIsReportedAndTheExecutorGoesOn) {
+  Executor ex("t");
+  std::mutex m;
+  std::vector<std::string> errors;
+  ex.on_error([&](const std::string& what) {
+    std::lock_guard<std::mutex> l(m);
+    errors.push_back(what);
+  });
+  std::atomic<int> after{0};
+  ex.post([] { throw std::runtime_error("disk full"); });
+  ex.post([&] { ++after; });
+  std::atomic<int> ticks{0};
+  auto timer = ex.every(1ms, [&] {
+    if (++ticks == 1) throw std::runtime_error("timer failed");
+  });
+  ex.start();
+  ASSERT_TRUE(eventually([&] { return ticks.load() >= 3; }));
+  timer.cancel();
+  ASSERT_TRUE(ex.run_sync([] {}, 5000ms));
+  EXPECT_EQ(after.load(), 1);
+  std::lock_guard<std::mutex> l(m);
+  ASSERT_EQ(errors.size(), 2u);
+  EXPECT_EQ(errors[0], "disk full");
+  EXPECT_EQ(errors[1], "timer failed");
 }

@@ -20,6 +20,7 @@
 #include "skelgraph/playback/readers.hpp"
 #include "skelgraph/recording/bag.hpp"
 #include "skelgraph/recording/session_recorder.hpp"
+#include "skelgraph/recording/tick_frames.hpp"
 #include "skelgraph/runtime/topics.hpp"
 #include "skelgraph/skeleton/skeleton_msg.hpp"
 
@@ -51,7 +52,8 @@ int info(const std::string& file, bool json) {
   // Ticks and sessions from the sync topic.
   std::uint64_t ticks = 0;
   std::set<std::uint32_t> sessions;
-  std::map<std::string, std::uint64_t> per_sensor, acks_by_host;
+  std::map<std::string, std::uint64_t> per_sensor, acks_by_host, ticks_with;
+  std::uint64_t tick_records = 0;
   std::map<std::string, nlohmann::json> clocks;
   reader.for_each_message([&](const mcap::Channel& ch, const mcap::Schema* schema, const mcap::Message& m) {
     if (schema == nullptr) return;
@@ -68,6 +70,12 @@ int info(const std::string& file, bool json) {
     } else if (schema->name == msg::MessageTraits<msg::Skeleton>::name) {
       const auto k = msg::from_cdr<msg::Skeleton>(m.data.data(), m.data.size());
       ++per_sensor[ch.topic + " " + k.sensor_id().to_string()];
+    } else if (schema->name == msg::MessageTraits<msg::TickFrames>::name) {
+      const auto t = msg::from_cdr<msg::TickFrames>(m.data.data(), m.data.size());
+      ++tick_records;
+      std::set<std::string> streams;  // a sensor counts once per tick, however many people it saw
+      for (const auto& f : t.frames()) streams.insert(f.topic().to_string() + " " + f.sensor_id().to_string());
+      for (const auto& k : streams) ++ticks_with[k];
     }
   });
   const double duration =
@@ -98,6 +106,8 @@ int info(const std::string& file, bool json) {
                            {"topics", topics},
                            {"skeletons_per_sensor", per_sensor},
                            {"ticks_acked_by_host", acks_by_host},
+                           {"tick_records", tick_records},
+                           {"ticks_with_frames_of", ticks_with},
                            {"clock_offsets", clocks},
                            {"metadata", metadata}};
   if (json) {
@@ -118,6 +128,10 @@ int info(const std::string& file, bool json) {
                   c["offset_ns"].get<double>() * 1e-6, c["drift_ppm"].get<double>(), c["rtt_ns"].get<double>() * 1e-6);
     }
     for (const auto& [k, n] : per_sensor) std::printf("  skeletons %-40s %8llu\n", k.c_str(), static_cast<unsigned long long>(n));
+    for (const auto& [k, n] : ticks_with) {
+      std::printf("  frames at ticks %-34s %8llu of %llu ticks\n", k.c_str(), static_cast<unsigned long long>(n),
+                  static_cast<unsigned long long>(tick_records));
+    }
     for (const auto& m : s.metadata) {
       std::printf("  metadata %s:", m.name.c_str());
       for (const auto& [k, v] : m.values) std::printf(" %s=%s", k.c_str(), v.c_str());
@@ -230,8 +244,10 @@ int recover(const std::string& in, const std::string& out, bool json) {
 // each file's log times are corrected by its host's clock offset (the latest
 // skelgraph/sync/clock estimate found in any input, drift included); a message
 // recorded by several hosts (same topic, same bytes) is kept once; repeats
-// within one recording are kept.
-int merge(const std::vector<std::string>& files, const std::string& out_path, mcap::Compression compression, bool json) {
+// within one recording are kept. Every sync tick gets a TickFrames record on
+// skelgraph/sync/tick_frames: the frame of each stream current at that tick.
+int merge(const std::vector<std::string>& files, const std::string& out_path, mcap::Compression compression,
+          double max_age_ms, bool json) {
   struct Input {
     std::string file, host;
   };
@@ -260,6 +276,7 @@ int merge(const std::vector<std::string>& files, const std::string& out_path, mc
     bool keyed;
     std::string data;
     std::uint64_t publish_time;
+    std::size_t input;
   };
   std::vector<Item> items;
   std::map<std::pair<std::string, std::string>, std::size_t> seen;  // (topic, bytes) -> the input that had it
@@ -288,7 +305,8 @@ int merge(const std::vector<std::string>& files, const std::string& out_path, mc
       if (ch.topic == runtime::topics::kSyncAck.name) {
         ++acks_by_host[msg::from_cdr<msg::SyncAck>(m.data.data(), m.data.size()).host().to_string()];
       }
-      items.push_back({static_cast<std::uint64_t>(std::max(0.0, corrected)), ch.topic, type, keyed, data, m.publish_time});
+      items.push_back(
+          {static_cast<std::uint64_t>(std::max(0.0, corrected)), ch.topic, type, keyed, data, m.publish_time, i});
     });
   }
   std::stable_sort(items.begin(), items.end(), [](const Item& a, const Item& b) { return a.time < b.time; });
@@ -303,13 +321,51 @@ int merge(const std::vector<std::string>& files, const std::string& out_path, mc
   }
   for (const auto& [host, n] : acks_by_host) meta["ticks_acked " + host] = std::to_string(n);
   bag.write_metadata("merge", meta);
-  for (const auto& it : items) bag.write_cdr(it.topic, it.type, it.keyed, it.data, it.time, it.publish_time);
+  recording::TickAssociator assoc(static_cast<std::int64_t>(max_age_ms * 1e6));
+  std::uint64_t tick_records = 0, frames_at_ticks = 0;
+  for (const auto& it : items) {
+    bag.write_cdr(it.topic, it.type, it.keyed, it.data, it.time, it.publish_time);
+    const auto* bytes = reinterpret_cast<const std::uint8_t*>(it.data.data());
+    msg::FrameRef f;
+    if (it.type == msg::MessageTraits<msg::Skeleton>::name) {
+      const auto k = msg::from_cdr<msg::Skeleton>(bytes, it.data.size());
+      f.sensor_id(k.sensor_id());
+      f.person_id(k.person_id());
+      f.frame_number(k.frame_number());
+      f.stamp_ns(k.stamp_ns());
+    } else if (it.type == msg::MessageTraits<msg::DepthFrame>::name) {
+      const auto d = msg::from_cdr<msg::DepthFrame>(bytes, it.data.size());
+      f.sensor_id(d.sensor_id());
+      f.frame_number(d.frame_number());
+      f.stamp_ns(d.stamp_ns());
+    } else if (it.topic == runtime::topics::kSync.name) {
+      const auto c = msg::from_cdr<msg::SyncCommand>(bytes, it.data.size());
+      if (c.kind() != msg::SYNC_TICK) continue;
+      const auto tf = assoc.tick(c.session_id(), c.tick(), c.master_stamp_ns(), static_cast<std::int64_t>(it.time));
+      bag.write(recording::kTickFramesTopic, tf, it.time, it.time);
+      ++tick_records;
+      frames_at_ticks += tf.frames().size();
+      continue;
+    } else {
+      continue;
+    }
+    f.topic(it.topic.substr(0, 128));
+    f.host(inputs[it.input].host.substr(0, 64));
+    f.log_time_ns(static_cast<std::int64_t>(it.time));
+    assoc.frame(f);
+  }
   bag.close();
-  const nlohmann::json report{{"out", out_path},       {"messages", items.size()}, {"duplicates_dropped", duplicates},
-                              {"inputs", applied},     {"ticks_acked_by_host", acks_by_host}};
+  const nlohmann::json report{{"out", out_path},
+                              {"messages", items.size() + tick_records},
+                              {"duplicates_dropped", duplicates},
+                              {"inputs", applied},
+                              {"ticks_acked_by_host", acks_by_host},
+                              {"tick_records", tick_records},
+                              {"frames_per_tick", tick_records > 0 ? static_cast<double>(frames_at_ticks) / tick_records : 0.0}};
   if (json) std::printf("%s\n", report.dump(2).c_str());
-  else std::printf("%s: %zu messages (%llu duplicates dropped) from %zu recordings\n", out_path.c_str(), items.size(),
-                   static_cast<unsigned long long>(duplicates), files.size());
+  else std::printf("%s: %zu messages (%llu duplicates dropped) from %zu recordings; %llu ticks, %.1f frames each\n",
+                   out_path.c_str(), items.size(), static_cast<unsigned long long>(duplicates), files.size(),
+                   static_cast<unsigned long long>(tick_records), report["frames_per_tick"].get<double>());
   return 0;
 }
 
@@ -336,6 +392,7 @@ void add_bag_command(CLI::App& app, GlobalOptions& g, Action& run) {
   struct Opts {
     std::string file, out, format = "csv", compression = "zstd", on_error = "stop", sensor_id;
     std::vector<std::string> files;
+    double max_age_ms = 100;
     bool json = false;
   };
   auto o = std::make_shared<Opts>();
@@ -424,9 +481,14 @@ void add_bag_command(CLI::App& app, GlobalOptions& g, Action& run) {
   mg->add_option("files", o->files, "recordings (one per host)")->required()->check(CLI::ExistingFile);
   mg->add_option("--out", o->out, "MCAP file to write")->required();
   mg->add_option("--compression", o->compression, "chunk compression")->check(CLI::IsMember({"none", "lz4", "zstd"}));
+  mg->add_option("--max-age-ms", o->max_age_ms,
+                 "a frame older than this at a tick is not associated with it (default 100 ms, 3 frames at 30 Hz)")
+      ->check(CLI::PositiveNumber);
   mg->add_flag("--json", o->json, "machine-readable summary");
   mg->callback([o, &run] {
-    run = [o] { return merge(o->files, o->out, *mcap::compression_from_name(o->compression), o->json); };
+    run = [o] {
+      return merge(o->files, o->out, *mcap::compression_from_name(o->compression), o->max_age_ms, o->json);
+    };
   });
 
   auto* rc = bag->add_subcommand("recover", "Salvage every complete chunk of a recording whose writer was killed");

@@ -22,6 +22,9 @@ runtime::ComponentInfo Recorder::describe() {
       .add_string("compression", "zstd", "chunk compression", {"none", "lz4", "zstd"})
       .add_int("flush_ms", 1000, "flush to disk at least this often: a killed recorder loses at most this much", 50, 60000)
       .add_string("host", "", "host name in file names and acks (default: the DDS host name)")
+      .add_int("stop_linger_ms", 300,
+               "keep recording this long after STOP, so samples in flight (the acks of the last tick) are in the file",
+               0, 10000)
       .add_bool("now", false, "record from start to shutdown without waiting for the sync topic")
       .add_string("label", "manual", "session label when recording with 'now'");
   return info;
@@ -32,6 +35,7 @@ Recorder::Recorder(runtime::Context& ctx, const runtime::Params& params)
       record_now_(params.get<bool>("now")),
       now_label_(params.get<std::string>("label")),
       ack_pub_(ctx, runtime::topics::kSyncAck) {
+  linger_ = std::chrono::milliseconds(params.get<std::int64_t>("stop_linger_ms"));
   options_.directory = params.get<std::string>("directory");
   options_.host = params.get<std::string>("host").empty() ? ctx.config().host : params.get<std::string>("host");
   options_.compression = *mcap::compression_from_name(params.get<std::string>("compression"));
@@ -66,15 +70,22 @@ void Recorder::on_start() {
     try {
       session_->maybe_flush(runtime::Context::now_ns());
     } catch (const std::exception& e) {
-      last_error_ = e.what();
-      ctx_.set_health(runtime::HealthState::Error, "recording stopped: " + last_error_);
-      spdlog::error("{}: {}", ctx_.name(), last_error_);
-      session_.reset();
+      fail(e.what());
     }
   });
 }
 
 void Recorder::on_shutdown() { close(); }
+
+// A write failed (disk full, device gone): stop this session and say why on the
+// status topic. What was flushed before stays readable (`bag recover`).
+void Recorder::fail(const std::string& what) {
+  last_error_ = what;
+  const std::string path = session_ ? session_->path() : std::string();
+  session_.reset();
+  ctx_.set_health(runtime::HealthState::Error, "recording stopped: " + what + (path.empty() ? "" : "; salvage with: skelgraph bag recover " + path));
+  spdlog::error("{}: recording stopped: {}", ctx_.name(), what);
+}
 
 void Recorder::open(const std::string& label, std::uint32_t session_id) {
   close();
@@ -89,13 +100,27 @@ void Recorder::open(const std::string& label, std::uint32_t session_id) {
   }
   ctx_.set_health(runtime::HealthState::Ok, "recording " + session_->path());
   spdlog::info("{}: recording session {} '{}' to {}", ctx_.name(), session_id, label, session_->path());
-  for (const auto& l : latched_) {
-    session_->record(l.topic, l.type_name, l.keyed,
-                     std::string_view(reinterpret_cast<const char*>(l.cdr.data()), l.cdr.size()), l.log_ns, l.publish_ns);
+  try {
+    for (const auto& l : latched_) {
+      session_->record(l.topic, l.type_name, l.keyed,
+                       std::string_view(reinterpret_cast<const char*>(l.cdr.data()), l.cdr.size()), l.log_ns,
+                       l.publish_ns);
+    }
+  } catch (const std::exception& e) {
+    fail(e.what());
   }
 }
 
+void Recorder::stop_session() {
+  if (!session_ || linger_timer_active_) return;
+  if (linger_.count() == 0) return close();
+  linger_timer_active_ = true;
+  linger_timer_ = ctx_.executor().every(linger_, [this] { close(); });
+}
+
 void Recorder::close() {
+  linger_timer_.cancel();
+  linger_timer_active_ = false;
   if (!session_) return;
   try {
     session_->finish(runtime::Context::now_ns());
@@ -103,7 +128,8 @@ void Recorder::close() {
     ctx_.set_health(runtime::HealthState::Ok, "wrote " + session_->path());
   } catch (const std::exception& e) {
     last_error_ = e.what();
-    ctx_.set_health(runtime::HealthState::Error, "cannot finish " + session_->path() + ": " + last_error_);
+    ctx_.set_health(runtime::HealthState::Error, "cannot finish " + session_->path() + ": " + last_error_ +
+                                                      "; salvage with: skelgraph bag recover " + session_->path());
   }
   session_.reset();
 }
@@ -134,9 +160,17 @@ void Recorder::on_sample(const runtime::TopicInfo& topic, bool keyed, const msg:
   if (sync && sync->kind() == msg::SYNC_START && !record_now_ && session_id_ != sync->session_id()) {
     open(sync->label().to_string(), sync->session_id());
   }
-  if (session_) session_->record(topic.name, topic.type_name, keyed, cdr, m.receive_ns, m.source_stamp_ns);
+  if (session_) {
+    try {
+      session_->record(topic.name, topic.type_name, keyed, cdr, m.receive_ns, m.source_stamp_ns);
+    } catch (const std::exception& e) {
+      fail(e.what());
+    }
+  }
   if (!sync || session_topic) {
-    if (sync && session_topic && sync->kind() == msg::SYNC_STOP && !record_now_ && session_id_ == sync->session_id()) close();
+    if (sync && session_topic && sync->kind() == msg::SYNC_STOP && !record_now_ && session_id_ == sync->session_id()) {
+      stop_session();
+    }
     return;
   }
   if (sync->kind() == msg::SYNC_TICK) {
@@ -151,7 +185,7 @@ void Recorder::on_sample(const runtime::TopicInfo& topic, bool keyed, const msg:
     ack_pub_.publish(ack);
     ++ticks_acked_;
   } else if (sync->kind() == msg::SYNC_STOP && !record_now_) {
-    close();
+    stop_session();
   }
 }
 

@@ -1,5 +1,6 @@
 #include "skelgraph/runtime/context.hpp"
 
+#include <cstdio>
 #include <cstdlib>
 #include <algorithm>
 #include <chrono>
@@ -41,6 +42,10 @@ void load_profile_file(const std::string& file) {
 
 Context::Context(std::string name, const DdsConfig& config, dds::DomainParticipantListener* listener)
     : name_(std::move(name)), config_(config), executor_(name_) {
+  executor_.on_error([this](const std::string& what) {
+    std::fprintf(stderr, "%s: unhandled error in a callback: %s\n", name_.c_str(), what.c_str());
+    set_health(HealthState::Error, "unhandled error: " + what);
+  });
   register_type_objects();
   const auto file = profile_file(config.profile);
   const auto profile = profile_name(config.profile);

@@ -1,5 +1,7 @@
 #include "skelgraph/runtime/executor.hpp"
 
+#include <cstdio>
+
 #include <future>
 
 namespace skelgraph::runtime {
@@ -96,6 +98,20 @@ bool Executor::run_sync(std::function<void()> task, std::chrono::milliseconds ti
   return fut.wait_for(timeout) == std::future_status::ready;
 }
 
+void Executor::run_guarded(const std::function<void()>& fn) {
+  std::string what;
+  try {
+    fn();
+    return;
+  } catch (const std::exception& e) {
+    what = e.what();
+  } catch (...) {
+    what = "unknown exception";
+  }
+  if (on_error_) on_error_(what);
+  else std::fprintf(stderr, "%s: unhandled error in a callback: %s\n", name_.c_str(), what.c_str());
+}
+
 void Executor::loop() {
   std::unique_lock<std::mutex> lock(mutex_);
   while (true) {
@@ -103,7 +119,7 @@ void Executor::loop() {
       auto task = std::move(tasks_.front());
       tasks_.pop_front();
       lock.unlock();
-      task();
+      run_guarded(task);
       lock.lock();
       continue;
     }
@@ -127,7 +143,7 @@ void Executor::loop() {
       {
         std::lock_guard<std::recursive_mutex> tl(due->mutex);
         if (!due->cancelled) {
-          due->fn();
+          run_guarded(due->fn);
           due->next += due->period;
           const auto after = std::chrono::steady_clock::now();
           if (due->next <= after) {

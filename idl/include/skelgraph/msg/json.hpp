@@ -24,6 +24,8 @@ void to_json(nlohmann::json& j, const SyncCommand& v);
 void to_json(nlohmann::json& j, const SyncControl& v);
 void to_json(nlohmann::json& j, const SyncAck& v);
 void to_json(nlohmann::json& j, const ClockOffset& v);
+void to_json(nlohmann::json& j, const FrameRef& v);
+void to_json(nlohmann::json& j, const TickFrames& v);
 void to_json(nlohmann::json& j, const SensorPose& v);
 void to_json(nlohmann::json& j, const CameraIntrinsics& v);
 void to_json(nlohmann::json& j, const DepthFrame& v);

@@ -8,6 +8,7 @@
 // for late joiners) go into every new file.
 // One recorder per host; several hosts record the same session.
 
+#include <chrono>
 #include <memory>
 #include <optional>
 #include <string>
@@ -39,6 +40,8 @@ class Recorder final : public runtime::Component {
   void on_sample(const runtime::TopicInfo& topic, bool keyed, const msg::RawSample& s, const runtime::SampleMeta& m);
   void open(const std::string& label, std::uint32_t session_id);
   void close();
+  void stop_session();  // close after the linger period
+  void fail(const std::string& what);
 
   RecorderOptions options_;
   bool record_now_;
@@ -46,6 +49,9 @@ class Recorder final : public runtime::Component {
   std::vector<std::unique_ptr<runtime::RawSubscription>> subs_;
   runtime::Publisher<msg::SyncAck> ack_pub_;
   runtime::TimerHandle flush_timer_;
+  std::chrono::milliseconds linger_{0};
+  runtime::TimerHandle linger_timer_;
+  bool linger_timer_active_ = false;
   std::unique_ptr<SessionRecorder> session_;
   std::vector<Latched> latched_;
   std::vector<std::string> topics_;

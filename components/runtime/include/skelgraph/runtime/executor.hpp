@@ -56,11 +56,17 @@ class Executor {
   // Late calls are not bunched: missed periods are skipped and counted.
   TimerHandle every(std::chrono::nanoseconds period, std::function<void()> fn, bool immediately = false);
 
+  // An exception escaping a task or timer is handed to `handler` (the
+  // component's context marks it ERROR) instead of ending the process; the
+  // executor goes on with the next task. Set before start().
+  void on_error(std::function<void(const std::string& what)> handler) { on_error_ = std::move(handler); }
+
   // Runs `task` on the executor thread and waits for it (returns false on timeout or if stopped).
   bool run_sync(std::function<void()> task, std::chrono::milliseconds timeout);
 
  private:
   void loop();
+  void run_guarded(const std::function<void()>& fn);
 
   std::string name_;
   mutable std::mutex mutex_;
@@ -69,6 +75,7 @@ class Executor {
   std::vector<std::shared_ptr<TimerHandle::State>> timers_;
   bool running_ = false;
   bool stopping_ = false;
+  std::function<void(const std::string&)> on_error_;
   std::thread thread_;
 };
 
