@@ -67,7 +67,7 @@ kill -INT "$sim"; wait "$sim" || true
 "$SKELGRAPH" bag record --now --label replay --dir "$WORK/replay" --duration 40 >/dev/null 2>"$WORK/r.err" &
 rec=$!
 sleep 2
-"$SKELGRAPH" bag play "$a_file" --duration 20 --json >"$WORK/play.json" 2>"$WORK/play.err" || fail "play: $(cat "$WORK/play.err")"
+timeout 60 "$SKELGRAPH" bag play "$a_file" --json >"$WORK/play.json" 2>"$WORK/play.err" || fail "play (ends by itself at the end of the file): $(cat "$WORK/play.err")"
 sleep 1
 kill -INT "$rec"; wait "$rec" || fail "re-record: $(cat "$WORK/r.err")"
 "$SKELGRAPH" bag info "$a_file" --json >"$WORK/orig.json"

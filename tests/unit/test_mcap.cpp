@@ -218,3 +218,21 @@ TEST(Mcap, FuzzRegressionInputsNeverCrash) {
   }
   EXPECT_GE(files, 1);
 }
+
+TEST(Mcap, ReaderNamesWhatIsNotARecording) {
+  try {
+    Reader r(std::string("/"));
+    FAIL() << "a directory was accepted";
+  } catch (const McapError& e) {
+    EXPECT_NE(std::string(e.what()).find("not a regular file"), std::string::npos) << e.what();
+  }
+  const auto empty = temp_path("empty.mcap");
+  spit(empty, "");
+  try {
+    Reader(empty).validate();
+    FAIL() << "an empty file was accepted";
+  } catch (const McapError& e) {
+    EXPECT_NE(std::string(e.what()).find("not an MCAP file"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(Reader(temp_path("does-not-exist.mcap")), McapError);
+}

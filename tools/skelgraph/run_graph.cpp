@@ -50,7 +50,11 @@ int run_graph(const runtime::ComponentRegistry& registry, const runtime::DdsConf
   while (!signalled) {
     const auto now = clock::now();
     if (now >= end) break;
-    const auto until = std::min({end, next_status, now + std::chrono::seconds(1)});
+    if (graph.finished()) {
+      spdlog::info("every component with an end has finished, stopping");
+      break;
+    }
+    const auto until = std::min({end, next_status, now + std::chrono::milliseconds(100)});
     signalled = wait_for_signal(std::chrono::duration_cast<std::chrono::milliseconds>(until - now) +
                                 std::chrono::milliseconds(1));
     if (clock::now() >= next_status) {

@@ -1,6 +1,9 @@
 #include "skelgraph/mcap/mcap.hpp"
 
+#include <fcntl.h>
 #include <lz4frame.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
 #include <unistd.h>
 #include <zlib.h>
 #include <zstd.h>
@@ -496,15 +499,54 @@ struct Reader::Scan {
   std::optional<std::uint64_t> stats_messages;
 };
 
-Reader::Reader(const std::string& path) : name_(path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw McapError("cannot open " + path + ": " + std::strerror(errno));
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  bytes_ = ss.str();
+namespace {
+
+struct Mapping {
+  void* data = nullptr;
+  std::size_t size = 0;
+  Mapping(void* d, std::size_t n) : data(d), size(n) {}
+  Mapping(const Mapping&) = delete;
+  Mapping& operator=(const Mapping&) = delete;
+  ~Mapping() { ::munmap(data, size); }
+};
+
+// The file's bytes, mapped read-only: recordings of depth streams are many GB.
+std::pair<std::shared_ptr<const void>, std::string_view> map_file(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw McapError("cannot open " + path + ": " + std::strerror(errno));
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    const int err = errno;
+    ::close(fd);
+    throw McapError("cannot read " + path + ": " + (S_ISREG(st.st_mode) ? std::strerror(err) : "not a regular file"));
+  }
+  const auto n = static_cast<std::size_t>(st.st_size);
+  if (n == 0) {
+    ::close(fd);
+    return {nullptr, std::string_view()};
+  }
+  void* p = ::mmap(nullptr, n, PROT_READ, MAP_PRIVATE, fd, 0);
+  const int err = errno;
+  ::close(fd);
+  if (p == MAP_FAILED) throw McapError("cannot map " + path + ": " + std::strerror(err));
+  ::madvise(p, n, MADV_SEQUENTIAL);
+  auto m = std::make_shared<Mapping>(p, n);
+  return {m, std::string_view(static_cast<const char*>(p), n)};
 }
 
-Reader::Reader(std::string bytes, std::string name) : bytes_(std::move(bytes)), name_(std::move(name)) {}
+}  // namespace
+
+Reader::Reader(const std::string& path) : name_(path) {
+  auto [storage, bytes] = map_file(path);
+  storage_ = std::move(storage);
+  bytes_ = bytes;
+}
+
+Reader::Reader(std::string bytes, std::string name) : name_(std::move(name)) {
+  auto owned = std::make_shared<const std::string>(std::move(bytes));
+  bytes_ = *owned;
+  storage_ = std::move(owned);
+}
 
 namespace {
 
@@ -708,11 +750,7 @@ void Reader::for_each_message(const MessageCallback& cb) const {
 // ---------------------------------------------------------------- recovery
 
 RecoveryReport recover(const std::string& in_path, const std::string& out_path, WriterOptions options) {
-  std::ifstream in(in_path, std::ios::binary);
-  if (!in) throw McapError("cannot open " + in_path + ": " + std::strerror(errno));
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  const std::string bytes = ss.str();
+  const auto [storage, bytes] = map_file(in_path);
   if (bytes.size() < kMagicSize || std::memcmp(bytes.data(), kMagic, kMagicSize) != 0) {
     throw McapError(in_path + ": not an MCAP file (no MCAP magic at the start)", 0);
   }

@@ -93,6 +93,16 @@ Component& Graph::add(const std::string& name, const std::string& kind, const Pa
   return *nodes_.back()->component;
 }
 
+bool Graph::finished() const {
+  bool any = false;
+  for (const auto& n : nodes_) {
+    if (!n->component->finite()) continue;
+    if (!n->component->finished()) return false;
+    any = true;
+  }
+  return any;
+}
+
 void Graph::add_all(const std::vector<ResolvedComponent>& components) {
   for (const auto& c : components) add(c.name, c.kind, c.params);
 }

@@ -135,7 +135,9 @@ struct Summary {
 
 class Reader {
  public:
-  // Reads the whole file into memory. Throws McapError (not an MCAP file, too short, unreadable).
+  // Maps the file read-only (memory is the page cache, not a copy; one chunk
+  // at a time is decompressed). Throws McapError (not an MCAP file, too
+  // short, unreadable). The file must not shrink while a Reader is open.
   explicit Reader(const std::string& path);
   // From bytes already in memory (`name` for messages).
   Reader(std::string bytes, std::string name);
@@ -150,12 +152,14 @@ class Reader {
   void for_each_message(const MessageCallback& cb) const;
 
   std::uint64_t size() const { return bytes_.size(); }
+  const std::string& name() const { return name_; }
 
  private:
   struct Scan;
   void scan(Scan& s, bool strict) const;
 
-  std::string bytes_;
+  std::shared_ptr<const void> storage_;  // the mapping, or the bytes given
+  std::string_view bytes_;
   std::string name_;
 };
 

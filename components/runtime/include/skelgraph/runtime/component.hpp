@@ -26,6 +26,10 @@ class Component {
   virtual void on_shutdown() {}
   // One line for the launcher's report ("42 ticks, session 7").
   virtual std::string summary() const { return {}; }
+  // A component with an end (a player at the end of its file) says so; a run
+  // of the graph ends when every such component has finished. Thread-safe.
+  virtual bool finite() const { return false; }
+  virtual bool finished() const { return false; }
   // The same, machine-readable, for `--json` reports (null when there is nothing).
   virtual nlohmann::json details() const { return nullptr; }
 

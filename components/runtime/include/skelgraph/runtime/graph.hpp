@@ -45,6 +45,9 @@ class Graph {
   void start();  // starts every executor, then on_start() of each component
   void stop();   // on_shutdown() of each (reverse order), then stops executors; idempotent
 
+  // True when the graph has components with an end and all of them have finished.
+  bool finished() const;
+
   // Call after stop(): components are not locked while they report.
   std::vector<NodeReport> report() const;
   Context& context(const std::string& name);
