@@ -48,6 +48,7 @@ print(json.dumps({
     "recorder_write_MB_per_s": rec_rate / 1e6 if rec_rate else None,
     "dd_same_bytes": dd, "dd_MB_per_s": dd_rate / 1e6 if dd_rate else None,
     "recorder_over_dd": (rec_rate / dd_rate) if rec_rate and dd_rate else None,
+    "recorder_io": rec["components"][0]["io"],
     "note": "the recorder writes what arrives (2 depth streams at 30 Hz are about 37 MB/s); dd shows what the disk can take",
 }, indent=2))
 PY

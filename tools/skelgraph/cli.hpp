@@ -53,5 +53,6 @@ void add_demo_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_components_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_sim_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_bag_command(CLI::App& app, GlobalOptions& g, Action& run);
+void add_eval_command(CLI::App& app, GlobalOptions& g, Action& run);
 
 }  // namespace skelgraph::cli

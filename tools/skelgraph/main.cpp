@@ -111,6 +111,7 @@ int main(int argc, char** argv) {
   add_components_command(app, g, run);
   add_sim_command(app, g, run);
   add_bag_command(app, g, run);
+  add_eval_command(app, g, run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

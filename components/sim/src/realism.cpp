@@ -7,27 +7,7 @@
 
 namespace skelgraph::sim {
 
-using skeleton::JointId;
-
-const std::array<const char*, kGroupCount>& group_names() {
-  static const std::array<const char*, kGroupCount> n{"Head", "Neck", "Torso", "Shoulders", "Elbows", "Hands"};
-  return n;
-}
-
 namespace {
-
-// Joint group of each canonical joint, or -1 (legs: the thesis measured the upper body only).
-int group_of(JointId j) {
-  switch (j) {
-    case JointId::Head: return 0;
-    case JointId::Neck: return 1;
-    case JointId::Torso: return 2;
-    case JointId::LeftShoulder: case JointId::RightShoulder: return 3;
-    case JointId::LeftElbow: case JointId::RightElbow: return 4;
-    case JointId::LeftHand: case JointId::RightHand: return 5;
-    default: return -1;
-  }
-}
 
 struct ThesisColumn {
   const char* scenario;
@@ -74,29 +54,19 @@ Figures simulate_figures(const std::string& scenario, const std::string& profile
   Simulation sim(cfg);
   const Eigen::Isometry3d world_from_sensor = cfg.sensors.front().world_from_sensor();
 
-  std::array<double, kGroupCount> joints_seen{}, tracked{}, error_sum{};
+  eval::Accumulator acc;
   const auto events = sim.advance(sim.duration() + 1.0);
-  const double frames = static_cast<double>(sim.frame_count(0));
+  std::uint64_t with_person = 0;
   for (const auto& e : events) {
     if (e.kind != SimEvent::Kind::Raw) continue;
-    const auto truth = sim.truth_at(e.t).front();
-    for (std::size_t j = 0; j < skeleton::kJointCount; ++j) {
-      const int g = group_of(skeleton::joint_at(j));
-      if (g < 0 || e.skeleton.joints[j].confidence < skeleton::kTracked) continue;
-      tracked[g] += 1;
-      error_sum[g] += (world_from_sensor * e.skeleton.joints[j].position - truth.joints[j].position).norm();
-    }
+    auto world = e.skeleton;
+    for (auto& j : world.joints) j.position = world_from_sensor * j.position;
+    acc.add(world, sim.truth_at(e.t).front());
+    ++with_person;
   }
-  for (std::size_t j = 0; j < skeleton::kJointCount; ++j) {
-    const int g = group_of(skeleton::joint_at(j));
-    if (g >= 0) joints_seen[g] += frames;
-  }
-  Figures f;
-  for (std::size_t g = 0; g < kGroupCount; ++g) {
-    f[g].detection_pct = joints_seen[g] > 0 ? 100.0 * tracked[g] / joints_seen[g] : 0.0;
-    f[g].error_cm = tracked[g] > 0 ? 100.0 * error_sum[g] / tracked[g] : std::nan("");
-  }
-  return f;
+  // Frames in which the tracker reported nobody count as not detected.
+  acc.add_missed(sim.frame_count(0) - std::min<std::uint64_t>(with_person, sim.frame_count(0)));
+  return acc.figures();
 }
 
 bool detection_close(double sim, double thesis) { return std::abs(sim - thesis) <= 20.0; }

@@ -28,24 +28,6 @@ int side_of(JointId j) {
   }
 }
 
-JointId mirror(JointId j) {
-  switch (j) {
-    case JointId::LeftShoulder: return JointId::RightShoulder;
-    case JointId::LeftElbow: return JointId::RightElbow;
-    case JointId::LeftHand: return JointId::RightHand;
-    case JointId::LeftHip: return JointId::RightHip;
-    case JointId::LeftKnee: return JointId::RightKnee;
-    case JointId::LeftFoot: return JointId::RightFoot;
-    case JointId::RightShoulder: return JointId::LeftShoulder;
-    case JointId::RightElbow: return JointId::LeftElbow;
-    case JointId::RightHand: return JointId::LeftHand;
-    case JointId::RightHip: return JointId::LeftHip;
-    case JointId::RightKnee: return JointId::LeftKnee;
-    case JointId::RightFoot: return JointId::LeftFoot;
-    default: return j;
-  }
-}
-
 bool is_arm(JointId j) {
   return j == JointId::LeftShoulder || j == JointId::LeftElbow || j == JointId::LeftHand ||
          j == JointId::RightShoulder || j == JointId::RightElbow || j == JointId::RightHand;
@@ -406,7 +388,7 @@ std::optional<skeleton::Skeleton> TrackerModel::observe(double t, const Scene& s
   const Vector3d origin = view_.config().position;
   for (std::size_t j = 0; j < kJointCount; ++j) {
     const JointId jid = skeleton::joint_at(j);
-    const std::size_t src = idx(flipped_ ? mirror(jid) : jid);  // where the reported joint really is
+    const std::size_t src = idx(flipped_ ? skeleton::mirror(jid) : jid);  // where the reported joint really is
     const Vector3d truth_pos = truth.joints[src].position;
     const Vector3d velocity = first_frame ? Vector3d::Zero() : Vector3d((truth_pos - last_truth_[src]) / dt);
     Vector3d pos = truth_pos - p_.lag_s * velocity;

@@ -21,4 +21,41 @@ std::optional<JointId> joint_from_name(std::string_view name) {
   return std::nullopt;
 }
 
+std::optional<Eigen::Vector3d> centre_of(const skeleton::Skeleton& s) {
+  const auto& torso = s[JointId::Torso];
+  if (torso.confidence > 0) return torso.position;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  int n = 0;
+  for (const auto& j : s.joints) {
+    if (j.confidence <= 0) continue;
+    sum += j.position;
+    ++n;
+  }
+  if (n == 0) return std::nullopt;
+  return sum / n;
+}
+
+JointId mirror(JointId id) {
+  switch (id) {
+    case JointId::LeftShoulder: return JointId::RightShoulder;
+    case JointId::LeftElbow: return JointId::RightElbow;
+    case JointId::LeftHand: return JointId::RightHand;
+    case JointId::LeftHip: return JointId::RightHip;
+    case JointId::LeftKnee: return JointId::RightKnee;
+    case JointId::LeftFoot: return JointId::RightFoot;
+    case JointId::RightShoulder: return JointId::LeftShoulder;
+    case JointId::RightElbow: return JointId::LeftElbow;
+    case JointId::RightHand: return JointId::LeftHand;
+    case JointId::RightHip: return JointId::LeftHip;
+    case JointId::RightKnee: return JointId::LeftKnee;
+    case JointId::RightFoot: return JointId::LeftFoot;
+    default: return id;
+  }
+}
+
+void swap_sides(Skeleton& s) {
+  const auto copy = s.joints;
+  for (std::size_t j = 0; j < kJointCount; ++j) s.joints[j] = copy[static_cast<std::size_t>(mirror(joint_at(j)))];
+}
+
 }  // namespace skelgraph::skeleton

@@ -12,17 +12,16 @@
 #include <string>
 #include <vector>
 
+#include "skelgraph/eval/metrics.hpp"
+
 namespace skelgraph::sim {
 
-inline constexpr std::size_t kGroupCount = 6;
-const std::array<const char*, kGroupCount>& group_names();  // Head, Neck, Torso, Shoulders, Elbows, Hands
+using eval::group_names;  // Head, Neck, Torso, Shoulders, Elbows, Hands
+using eval::kGroupCount;
 inline const std::vector<std::string> kThesisScenarios{"walk", "360", "hide", "box", "occ", "sit", "arms"};
 
-struct GroupFigures {
-  double detection_pct = 0.0;  // share of frames with confidence 1
-  double error_cm = 0.0;       // mean error over those
-};
-using Figures = std::array<GroupFigures, kGroupCount>;
+using eval::Figures;  // per group: detection_pct (confidence 1), error_cm (mean over those)
+using eval::GroupFigures;
 
 // Tables 5.1 and 5.2 of the thesis. Throws std::invalid_argument for a scenario or profile it does not have.
 Figures thesis_figures(const std::string& scenario, const std::string& profile);

@@ -62,4 +62,13 @@ struct Skeleton {
   const Joint& operator[](JointId id) const { return joints[static_cast<std::size_t>(id)]; }
 };
 
+// Where a skeleton is: the torso if reported, else the mean of the joints
+// reported with any confidence. Empty when nothing is.
+std::optional<Eigen::Vector3d> centre_of(const Skeleton& s);
+
+// The joint on the other side of the body (left hand <-> right hand); itself for the spine.
+JointId mirror(JointId id);
+// Swaps every left joint with its right counterpart (a tracker that sees the back labels them the other way round).
+void swap_sides(Skeleton& s);
+
 }  // namespace skelgraph::skeleton

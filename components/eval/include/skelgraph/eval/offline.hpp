@@ -1,0 +1,61 @@
+#pragma once
+// Offline evaluation of fusion: raw skeletons and ground truth in time order
+// go through one Fuser per method (and one per single sensor, so single
+// sensors are measured on the same output ticks), and every stream is scored
+// against the truth at its tick. DDS-free and single-threaded; `skelgraph
+// eval` feeds it from the simulator or from a recording.
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "skelgraph/eval/metrics.hpp"
+#include "skelgraph/fusion/fuser.hpp"
+#include "skelgraph/skeleton/skeleton.hpp"
+
+namespace skelgraph::eval {
+
+struct TimedSkeleton {
+  enum class Kind { Raw, Truth };
+  Kind kind = Kind::Raw;
+  std::int64_t t_ns = 0;       // arrival (raw) or truth time, on one clock
+  skeleton::Skeleton skeleton;  // raw: its sensor's frame; truth: world
+};
+
+struct OfflineOptions {
+  std::vector<fusion::Method> methods = {fusion::Method::Avg, fusion::Method::Sum, fusion::Method::Facing,
+                                         fusion::Method::Weighted, fusion::Method::Kalman};
+  fusion::FuserOptions fuser;        // method is set per stream
+  std::int64_t period_ns = 33'333'333;  // output ticks (30 Hz)
+  bool singles = true;                // also every sensor on its own
+};
+
+struct StreamScore {
+  std::string name;      // a sensor id, or a method name
+  bool fused = false;
+  Accumulator accuracy;  // against truth (empty without truth)
+  Steadiness steadiness;
+  std::uint64_t ticks = 0, with_output = 0;
+};
+
+struct OfflineResult {
+  std::vector<StreamScore> streams;  // singles first (sensor order), then methods
+  std::uint64_t ticks = 0;
+  bool has_truth = false;
+  std::vector<fusion::FuserStats> fuser_stats;  // per stream
+};
+
+// Called with every fused skeleton of every method (e.g. to write them to a recording).
+using FusedSink = std::function<void(fusion::Method, const skeleton::Skeleton&)>;
+
+// `events` in time order. Ticks run from the first raw event to the last at
+// `period_ns`; a tick counts for accuracy when truth covers it.
+OfflineResult evaluate(const std::map<std::string, Eigen::Isometry3d>& world_from_sensor,
+                       const std::vector<TimedSkeleton>& events, const OfflineOptions& options,
+                       const FusedSink& sink = {});
+
+}  // namespace skelgraph::eval

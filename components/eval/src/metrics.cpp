@@ -1,0 +1,185 @@
+#include "skelgraph/eval/metrics.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace skelgraph::eval {
+
+using skeleton::JointId;
+
+const std::array<const char*, kGroupCount>& group_names() {
+  static const std::array<const char*, kGroupCount> n{"Head", "Neck", "Torso", "Shoulders", "Elbows", "Hands"};
+  return n;
+}
+
+int group_of(JointId j) {
+  switch (j) {
+    case JointId::Head: return 0;
+    case JointId::Neck: return 1;
+    case JointId::Torso: return 2;
+    case JointId::LeftShoulder:
+    case JointId::RightShoulder: return 3;
+    case JointId::LeftElbow:
+    case JointId::RightElbow: return 4;
+    case JointId::LeftHand:
+    case JointId::RightHand: return 5;
+    default: return -1;
+  }
+}
+
+void Accumulator::add(const skeleton::Skeleton& estimate, const skeleton::Skeleton& truth) {
+  for (std::size_t j = 0; j < skeleton::kJointCount; ++j) {
+    const int g = group_of(skeleton::joint_at(j));
+    if (g < 0) continue;
+    joint_frames_[g] += 1;
+    if (estimate.joints[j].confidence < skeleton::kTracked) continue;
+    tracked_[g] += 1;
+    error_sum_[g] += (estimate.joints[j].position - truth.joints[j].position).norm();
+  }
+}
+
+void Accumulator::add_missed(std::uint64_t frames) {
+  for (std::size_t j = 0; j < skeleton::kJointCount; ++j) {
+    const int g = group_of(skeleton::joint_at(j));
+    if (g >= 0) joint_frames_[g] += static_cast<double>(frames);
+  }
+}
+
+Figures Accumulator::figures() const {
+  Figures f;
+  for (std::size_t g = 0; g < kGroupCount; ++g) {
+    f[g].joint_frames = static_cast<std::uint64_t>(joint_frames_[g]);
+    f[g].tracked = static_cast<std::uint64_t>(tracked_[g]);
+    f[g].detection_pct = joint_frames_[g] > 0 ? 100.0 * tracked_[g] / joint_frames_[g] : 0.0;
+    f[g].error_cm = tracked_[g] > 0 ? 100.0 * error_sum_[g] / tracked_[g] : std::nan("");
+  }
+  return f;
+}
+
+double Accumulator::mean_error_cm() const {
+  double n = 0, sum = 0;
+  for (std::size_t g = 0; g < kGroupCount; ++g) {
+    n += tracked_[g];
+    sum += error_sum_[g];
+  }
+  return n > 0 ? 100.0 * sum / n : std::nan("");
+}
+
+double Accumulator::mean_group_error_cm() const {
+  double sum = 0;
+  int groups = 0;
+  for (const auto& g : figures()) {
+    if (std::isnan(g.error_cm)) continue;
+    sum += g.error_cm;
+    ++groups;
+  }
+  return groups > 0 ? sum / groups : std::nan("");
+}
+
+void TruthTimeline::add(const skeleton::Skeleton& truth, std::int64_t t_ns) {
+  auto& v = by_person_[truth.person_id];
+  if (!v.empty() && t_ns < v.back().first) {
+    const auto it = std::upper_bound(v.begin(), v.end(), t_ns, [](std::int64_t t, const auto& p) { return t < p.first; });
+    v.insert(it, {t_ns, truth});
+  } else {
+    v.emplace_back(t_ns, truth);
+  }
+}
+
+namespace {
+// Truth of one person at t, interpolated; empty if no sample is close enough.
+std::optional<skeleton::Skeleton> interpolate(const std::vector<std::pair<std::int64_t, skeleton::Skeleton>>& v,
+                                              std::int64_t t, std::int64_t max_gap) {
+  if (v.empty()) return std::nullopt;
+  const auto after = std::lower_bound(v.begin(), v.end(), t, [](const auto& p, std::int64_t x) { return p.first < x; });
+  if (after != v.end() && after->first == t) return after->second;
+  if (after == v.begin()) return after->first - t <= max_gap ? std::optional(after->second) : std::nullopt;
+  const auto before = std::prev(after);
+  if (after == v.end()) return t - before->first <= max_gap ? std::optional(before->second) : std::nullopt;
+  if (after->first - before->first > 2 * max_gap) return std::nullopt;
+  const double a = static_cast<double>(t - before->first) / static_cast<double>(after->first - before->first);
+  skeleton::Skeleton s = before->second;
+  for (std::size_t j = 0; j < skeleton::kJointCount; ++j) {
+    s.joints[j].position = (1 - a) * before->second.joints[j].position + a * after->second.joints[j].position;
+  }
+  s.stamp_ns = t;
+  return s;
+}
+}  // namespace
+
+std::optional<skeleton::Skeleton> TruthTimeline::at(std::int64_t t_ns, const Eigen::Vector3d& near,
+                                                    std::int64_t max_gap_ns) const {
+  std::optional<skeleton::Skeleton> best;
+  double best_d = std::numeric_limits<double>::infinity();
+  for (const auto& [id, v] : by_person_) {
+    auto s = interpolate(v, t_ns, max_gap_ns);
+    if (!s) continue;
+    const double d = ((*s)[JointId::Torso].position - near).norm();
+    if (d < best_d) {
+      best_d = d;
+      best = std::move(s);
+    }
+  }
+  return best;
+}
+
+bool TruthTimeline::covers(std::int64_t t_ns, std::int64_t max_gap_ns) const {
+  return std::any_of(by_person_.begin(), by_person_.end(),
+                     [&](const auto& p) { return interpolate(p.second, t_ns, max_gap_ns).has_value(); });
+}
+
+namespace {
+struct Bone {
+  const char* name;
+  JointId a, b;
+};
+constexpr Bone kBones[] = {{"neck-head", JointId::Neck, JointId::Head},
+                           {"torso-neck", JointId::Torso, JointId::Neck},
+                           {"left upper arm", JointId::LeftShoulder, JointId::LeftElbow},
+                           {"left forearm", JointId::LeftElbow, JointId::LeftHand},
+                           {"right upper arm", JointId::RightShoulder, JointId::RightElbow},
+                           {"right forearm", JointId::RightElbow, JointId::RightHand},
+                           {"shoulders", JointId::LeftShoulder, JointId::RightShoulder}};
+}  // namespace
+
+void Steadiness::add(const skeleton::Skeleton& s) {
+  ++frames_;
+  bool complete = true;
+  for (std::size_t j = 0; j < skeleton::kJointCount; ++j) {
+    if (group_of(skeleton::joint_at(j)) >= 0 && s.joints[j].confidence < skeleton::kTracked) complete = false;
+  }
+  if (complete) ++complete_;
+  for (const auto& b : kBones) {
+    if (s[b.a].confidence < skeleton::kTracked || s[b.b].confidence < skeleton::kTracked) continue;
+    const double len = (s[b.a].position - s[b.b].position).norm();
+    auto& m = bones_[b.name];
+    m.n += 1;
+    m.sum += len;
+    m.sum2 += len * len;
+  }
+}
+
+double Steadiness::upper_body_complete_pct() const {
+  return frames_ > 0 ? 100.0 * static_cast<double>(complete_) / static_cast<double>(frames_) : 0.0;
+}
+
+std::map<std::string, double> Steadiness::bone_sd_cm() const {
+  std::map<std::string, double> out;
+  for (const auto& [name, m] : bones_) {
+    if (m.n < 2) continue;
+    const double mean = m.sum / m.n;
+    out[name] = 100.0 * std::sqrt(std::max(0.0, m.sum2 / m.n - mean * mean));
+  }
+  return out;
+}
+
+double Steadiness::mean_bone_sd_cm() const {
+  const auto sd = bone_sd_cm();
+  if (sd.empty()) return std::nan("");
+  double sum = 0;
+  for (const auto& [n, v] : sd) sum += v;
+  return sum / static_cast<double>(sd.size());
+}
+
+}  // namespace skelgraph::eval

@@ -1,0 +1,97 @@
+#include "skelgraph/eval/offline.hpp"
+
+#include <algorithm>
+
+namespace skelgraph::eval {
+
+OfflineResult evaluate(const std::map<std::string, Eigen::Isometry3d>& world_from_sensor,
+                       const std::vector<TimedSkeleton>& events, const OfflineOptions& options,
+                       const FusedSink& sink) {
+  struct Lane {
+    StreamScore score;
+    fusion::Fuser fuser;
+    std::string only_sensor;  // singles: the one sensor fed
+    fusion::Method method;
+  };
+  std::vector<Lane> lanes;
+  std::vector<std::string> sensor_ids;
+  for (const auto& e : events) {
+    if (e.kind == TimedSkeleton::Kind::Raw &&
+        std::find(sensor_ids.begin(), sensor_ids.end(), e.skeleton.sensor_id) == sensor_ids.end()) {
+      sensor_ids.push_back(e.skeleton.sensor_id);
+    }
+  }
+  auto make_lane = [&](const std::string& name, bool fused, fusion::Method m, const std::string& only) {
+    auto fo = options.fuser;
+    fo.method = m;
+    Lane lane{{}, fusion::Fuser(fo), only, m};
+    lane.score.name = name;
+    lane.score.fused = fused;
+    for (const auto& [id, pose] : world_from_sensor) lane.fuser.set_pose(id, pose);
+    lanes.push_back(std::move(lane));
+  };
+  if (options.singles) {
+    for (const auto& id : sensor_ids) make_lane(id, false, fusion::Method::Avg, id);
+  }
+  for (const auto m : options.methods) make_lane(fusion::method_name(m), true, m, "");
+
+  OfflineResult result;
+  TruthTimeline truth;
+  std::int64_t first = 0, last = 0;
+  bool any_raw = false;
+  for (const auto& e : events) {
+    if (e.kind == TimedSkeleton::Kind::Truth) {
+      truth.add(e.skeleton, e.t_ns);
+      result.has_truth = true;
+    } else {
+      if (!any_raw) first = e.t_ns;
+      last = std::max(last, e.t_ns);
+      any_raw = true;
+    }
+  }
+  if (!any_raw) return result;
+  std::size_t next = 0;
+  for (std::int64_t tick = first; tick <= last + options.period_ns; tick += options.period_ns) {
+    // Everything that arrived up to this tick goes in first.
+    for (; next < events.size() && events[next].t_ns <= tick; ++next) {
+      const auto& e = events[next];
+      if (e.kind != TimedSkeleton::Kind::Raw) continue;
+      for (auto& lane : lanes) {
+        if (lane.only_sensor.empty() || lane.only_sensor == e.skeleton.sensor_id) lane.fuser.add(e.skeleton, e.t_ns);
+      }
+    }
+    ++result.ticks;
+    const std::int64_t at = tick - options.fuser.delay_ns;
+    const bool truth_here = truth.covers(at);
+    for (auto& lane : lanes) {
+      const auto fused = lane.fuser.fuse(tick);
+      ++lane.score.ticks;
+      if (sink && lane.only_sensor.empty()) {
+        for (const auto& f : fused) sink(lane.method, f);
+      }
+      if (!fused.empty()) ++lane.score.with_output;
+      for (const auto& f : fused) lane.score.steadiness.add(f);
+      if (!truth_here) continue;
+      // Each true person is scored against the fused person nearest it; a
+      // person nobody reports is a missed frame.
+      bool scored = false;
+      for (const auto& f : fused) {
+        const auto c = skeleton::centre_of(f);
+        if (!c) continue;
+        const auto t = truth.at(at, *c);
+        if (!t || ((*t)[skeleton::JointId::Torso].position - *c).norm() > 1.0) continue;  // a ghost, not the person
+        lane.score.accuracy.add(f, *t);
+        scored = true;
+        break;
+      }
+      if (!scored) lane.score.accuracy.add_missed();
+    }
+  }
+  for (auto& lane : lanes) {
+    result.streams.push_back(std::move(lane.score));
+    result.fuser_stats.push_back(lane.fuser.stats());
+  }
+  return result;
+}
+
+}  // namespace skelgraph::eval

@@ -1,0 +1,85 @@
+#pragma once
+// One skeleton per person from many unsynchronised sensors. DDS-free: raw
+// skeletons go in with the time they arrived (the caller's clock), fused
+// skeletons come out in the world frame at whatever times the caller asks
+// (sync ticks, or a fixed rate). The `fusion` component and `skelgraph fuse`
+// drive the same core, so live and offline results agree.
+//
+// Methods (per joint, over the sensors that currently see the person):
+//  avg      the thesis's: one sensor with confidence 1 -> take it; several ->
+//           their mean. No sensor at 1 -> the same over confidence 0.5.
+//  sum      the thesis's: among sensors with confidence 1 for the joint, the
+//           one whose skeleton has the highest confidence sum.
+//  facing   the sensor the torso faces (the thesis's first demo), else any.
+//  weighted mean weighted by confidence, view angle and distance.
+//  kalman   a constant-velocity filter per joint; measurement noise from
+//           confidence, view angle and distance; Mahalanobis gating; sensors
+//           seeing the person's back (left/right swapped) are detected against
+//           the person's heading and corrected; limb lengths held steady.
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "skelgraph/skeleton/skeleton.hpp"
+
+namespace skelgraph::fusion {
+
+enum class Method { Avg, Sum, Facing, Weighted, Kalman };
+const std::vector<std::string>& method_names();  // "avg", "sum", "facing", "weighted", "kalman"
+std::optional<Method> method_from_name(std::string_view name);
+const char* method_name(Method m);
+
+struct FuserOptions {
+  Method method = Method::Kalman;
+  std::int64_t max_age_ns = 100'000'000;          // older samples are not used at a fusion time
+  std::int64_t delay_ns = 0;                       // fuse this far in the past (room to interpolate)
+  bool interpolate = true;                         // between the samples around the fusion time, when both exist
+  std::int64_t sensor_timeout_ns = 1'000'000'000;  // silent this long: the sensor is dropped (degraded)
+  std::int64_t person_timeout_ns = 1'000'000'000;  // no input this long: the fused person is forgotten
+  double match_distance_m = 0.6;                   // a sensor's skeleton joins a fused person this close (torso)
+};
+
+struct FuserStats {
+  std::uint64_t added = 0, no_pose = 0, fused = 0, flips_corrected = 0, gated = 0;
+};
+
+class Fuser {
+ public:
+  explicit Fuser(FuserOptions options);
+  ~Fuser();
+  Fuser(Fuser&&) noexcept;
+  Fuser& operator=(Fuser&&) noexcept;
+
+  // Where a sensor is: p_world = world_from_sensor * p_sensor. Samples of a
+  // sensor without a pose are counted and ignored.
+  void set_pose(const std::string& sensor, const Eigen::Isometry3d& world_from_sensor);
+  bool has_pose(const std::string& sensor) const;
+
+  // A raw skeleton in its sensor's frame, received at t_ns.
+  void add(const skeleton::Skeleton& raw, std::int64_t t_ns);
+
+  // The fused skeleton of every person seen at t_ns (minus delay): world
+  // frame, sensor_id "fused", stable person ids, joint sensor_mask bit i =
+  // sensors()[i] contributed. Call with non-decreasing times.
+  std::vector<skeleton::Skeleton> fuse(std::int64_t t_ns);
+
+  // Every sensor seen so far, in mask-bit order.
+  std::vector<std::string> sensors() const;
+  // Sensors that sent data before but none within the timeout at t_ns.
+  std::vector<std::string> silent_sensors(std::int64_t t_ns) const;
+  const FuserStats& stats() const;
+  const FuserOptions& options() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace skelgraph::fusion

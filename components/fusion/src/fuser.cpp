@@ -1,0 +1,477 @@
+#include "skelgraph/fusion/fuser.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <deque>
+#include <limits>
+
+#include "skelgraph/fusion/joint_filter.hpp"
+
+namespace skelgraph::fusion {
+
+using skeleton::JointId;
+using skeleton::kInferred;
+using skeleton::kJointCount;
+using skeleton::kTracked;
+using Eigen::Vector3d;
+
+const std::vector<std::string>& method_names() {
+  static const std::vector<std::string> n{"avg", "sum", "facing", "weighted", "kalman"};
+  return n;
+}
+
+std::optional<Method> method_from_name(std::string_view name) {
+  const auto& n = method_names();
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    if (n[i] == name) return static_cast<Method>(i);
+  }
+  return std::nullopt;
+}
+
+const char* method_name(Method m) { return method_names()[static_cast<std::size_t>(m)].c_str(); }
+
+namespace {
+
+constexpr std::size_t kHistory = 4;          // samples kept per stream (enough to interpolate behind)
+constexpr double kGate = 16.27;              // chi-square, 3 dof, 99.9 %
+constexpr int kResetAfterMisses = 5;         // all measurements gated this often in a row: start over
+constexpr std::int64_t kCoastNs = 200'000'000;  // a filtered joint without measurements stays "inferred" this long
+
+struct Sample {
+  std::int64_t t;
+  skeleton::Skeleton world;
+};
+
+struct Stream {
+  std::size_t sensor;
+  std::deque<Sample> samples;
+  std::optional<std::uint32_t> track;
+};
+
+struct SensorInfo {
+  std::string id;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  bool has_pose = false;
+  std::int64_t last_ns = std::numeric_limits<std::int64_t>::min();
+};
+
+struct View {
+  Stream* stream;
+  std::size_t sensor;
+  skeleton::Skeleton s;
+  Vector3d centre;
+  double facing = 0;     // cos of the angle between the person's heading and the way to the sensor
+  double conf_sum = 0;
+  bool flipped = false;
+};
+
+struct Bone {
+  JointId parent, child;
+};
+constexpr Bone kLimbs[] = {{JointId::LeftShoulder, JointId::LeftElbow},   {JointId::LeftElbow, JointId::LeftHand},
+                           {JointId::RightShoulder, JointId::RightElbow}, {JointId::RightElbow, JointId::RightHand},
+                           {JointId::Neck, JointId::Head}};
+
+struct Track {
+  std::uint32_t id = 0;
+  std::int64_t last_ns = 0;
+  Vector3d centre = Vector3d::Zero();
+  std::optional<Vector3d> heading;  // horizontal unit vector the torso faces
+  std::array<JointFilter, kJointCount> filters;
+  std::array<int, kJointCount> misses{};
+  std::array<std::int64_t, kJointCount> last_update_ns{};
+  std::array<double, std::size(kLimbs)> bone_sum{}, bone_n{};
+  skeleton::Skeleton last;  // last output
+  std::uint64_t frames = 0;
+};
+
+// The way the torso faces, from the shoulders as this view labels them (horizontal, unit), if it has them.
+std::optional<Vector3d> claimed_heading(const skeleton::Skeleton& s) {
+  const auto& l = s[JointId::LeftShoulder];
+  const auto& r = s[JointId::RightShoulder];
+  if (l.confidence <= 0 || r.confidence <= 0) return std::nullopt;
+  // y up, right-handed: left = up x forward, so forward = left x up.
+  Vector3d f = (l.position - r.position).cross(Vector3d::UnitY());
+  f.y() = 0;
+  if (f.norm() < 1e-6) return std::nullopt;
+  return f.normalized();
+}
+
+}  // namespace
+
+struct Fuser::Impl {
+  FuserOptions opt;
+  FuserStats stats;
+  std::vector<SensorInfo> sensors;
+  std::map<std::pair<std::size_t, std::uint32_t>, Stream> streams;  // (sensor, raw person id)
+  std::vector<Track> tracks;
+  std::uint32_t next_track_id = 1;
+  std::uint64_t frame_number = 0;
+
+  std::size_t sensor_index(const std::string& id) {
+    for (std::size_t i = 0; i < sensors.size(); ++i) {
+      if (sensors[i].id == id) return i;
+    }
+    sensors.push_back({id});
+    return sensors.size() - 1;
+  }
+
+  Vector3d sensor_position(std::size_t i) const { return sensors[i].pose.translation(); }
+
+  // The stream's skeleton at t: interpolated between the samples around t when
+  // both exist, else the latest before t if it is recent enough.
+  std::optional<skeleton::Skeleton> view_at(const Stream& st, std::int64_t t) const {
+    const Sample* before = nullptr;
+    const Sample* after = nullptr;
+    for (const auto& s : st.samples) {
+      if (s.t <= t) before = &s;
+      else if (after == nullptr) after = &s;
+    }
+    if (before == nullptr || t - before->t > opt.max_age_ns) return std::nullopt;
+    if (!opt.interpolate || after == nullptr || before->t == t) return before->world;
+    const double a = static_cast<double>(t - before->t) / static_cast<double>(after->t - before->t);
+    skeleton::Skeleton s = before->world;
+    for (std::size_t j = 0; j < kJointCount; ++j) {
+      const auto& b = before->world.joints[j];
+      const auto& c = after->world.joints[j];
+      if (b.confidence <= 0 || c.confidence <= 0) continue;  // a joint that appears or vanishes is not blended
+      s.joints[j].position = (1 - a) * b.position + a * c.position;
+      s.joints[j].confidence = std::min(b.confidence, c.confidence);
+    }
+    return s;
+  }
+
+  Track& track_by_id(std::uint32_t id) {
+    return *std::find_if(tracks.begin(), tracks.end(), [&](const Track& t) { return t.id == id; });
+  }
+  bool has_track(std::uint32_t id) const {
+    return std::any_of(tracks.begin(), tracks.end(), [&](const Track& t) { return t.id == id; });
+  }
+
+  // Assigns each view to a fused person: the one its stream belonged to if it
+  // is still close, else the nearest without a view from the same sensor,
+  // else a new one.
+  std::map<std::uint32_t, std::vector<View*>> associate(std::vector<View>& views, std::int64_t t) {
+    std::map<std::uint32_t, std::vector<View*>> by_track;
+    auto taken = [&](std::uint32_t id, std::size_t sensor) {
+      const auto it = by_track.find(id);
+      return it != by_track.end() &&
+             std::any_of(it->second.begin(), it->second.end(), [&](const View* v) { return v->sensor == sensor; });
+    };
+    std::vector<View*> open;
+    for (auto& v : views) {
+      const auto& bound = v.stream->track;
+      if (bound && has_track(*bound) && !taken(*bound, v.sensor) &&
+          (track_by_id(*bound).centre - v.centre).norm() < 2 * opt.match_distance_m) {
+        by_track[*bound].push_back(&v);
+      } else {
+        open.push_back(&v);
+      }
+    }
+    for (View* v : open) {
+      Track* best = nullptr;
+      double best_d = opt.match_distance_m;
+      for (auto& tr : tracks) {
+        if (taken(tr.id, v->sensor)) continue;
+        // Compare with where the person is now if another sensor already placed it this round.
+        Vector3d c = tr.centre;
+        const auto it = by_track.find(tr.id);
+        if (it != by_track.end() && !it->second.empty()) c = it->second.front()->centre;
+        const double d = (c - v->centre).norm();
+        if (d < best_d) {
+          best_d = d;
+          best = &tr;
+        }
+      }
+      if (best == nullptr) {
+        Track nt;
+        nt.id = next_track_id++;
+        nt.centre = v->centre;
+        nt.last_ns = t;
+        tracks.push_back(std::move(nt));
+        best = &tracks.back();
+      }
+      v->stream->track = best->id;
+      by_track[best->id].push_back(v);
+    }
+    return by_track;
+  }
+
+  // Heading of the person and, against it, which views see the back (their
+  // left and right swapped). The heading starts once the views agree on it.
+  void update_heading(Track& tr, std::vector<View*>& vs, bool correct_flips) {
+    std::vector<std::pair<View*, Vector3d>> claims;
+    for (View* v : vs) {
+      if (auto f = claimed_heading(v->s)) claims.emplace_back(v, *f);
+    }
+    if (!tr.heading) {
+      bool agree = !claims.empty();
+      for (std::size_t i = 0; i < claims.size(); ++i) {
+        for (std::size_t k = i + 1; k < claims.size(); ++k) agree = agree && claims[i].second.dot(claims[k].second) > 0;
+      }
+      if (agree) {
+        Vector3d sum = Vector3d::Zero();
+        for (const auto& c : claims) sum += c.second;
+        if (sum.norm() > 1e-6) tr.heading = sum.normalized();
+      }
+    } else {
+      Vector3d sum = Vector3d::Zero();
+      for (auto& [v, f] : claims) {
+        if (f.dot(*tr.heading) < -0.2) {  // this sensor sees the back and labels it as the front
+          v->flipped = true;
+          f = -f;
+          if (correct_flips) {
+            skeleton::swap_sides(v->s);
+            ++stats.flips_corrected;
+          }
+        }
+        sum += f;
+      }
+      if (sum.norm() > 1e-6) tr.heading = (0.7 * *tr.heading + 0.3 * sum.normalized()).normalized();
+    }
+    for (View* v : vs) {
+      Vector3d to_sensor = sensor_position(v->sensor) - v->centre;
+      to_sensor.y() = 0;
+      const auto own = claimed_heading(v->s);
+      const Vector3d h = tr.heading ? *tr.heading : (own ? *own : Vector3d::Zero());
+      v->facing = to_sensor.norm() > 1e-6 ? h.dot(to_sensor.normalized()) : 0.0;
+      v->conf_sum = 0;
+      for (const auto& j : v->s.joints) v->conf_sum += j.confidence;
+    }
+  }
+
+  // One joint by a selection/averaging method. Returns false when no view reports it.
+  bool fuse_joint_simple(Method m, std::size_t j, const std::vector<View*>& vs, skeleton::Joint& out) {
+    for (const float level : {kTracked, kInferred}) {
+      std::vector<const View*> cand;
+      for (const View* v : vs) {
+        if (v->s.joints[j].confidence >= level) cand.push_back(v);
+      }
+      if (cand.empty()) continue;
+      out.confidence = level;
+      out.sensor_mask = 0;
+      if (m == Method::Avg) {
+        Vector3d sum = Vector3d::Zero();
+        for (const View* v : cand) {
+          sum += v->s.joints[j].position;
+          out.sensor_mask |= 1u << v->sensor;
+        }
+        out.position = sum / static_cast<double>(cand.size());
+      } else if (m == Method::Weighted) {
+        Vector3d sum = Vector3d::Zero();
+        double wsum = 0;
+        for (const View* v : vs) {
+          const auto& jj = v->s.joints[j];
+          if (jj.confidence < kInferred) continue;
+          const double d = std::max(0.5, (jj.position - sensor_position(v->sensor)).norm());
+          const double w = (jj.confidence >= kTracked ? 1.0 : 0.15) * (0.25 + 0.75 * (v->facing + 1) / 2) / (d * d);
+          sum += w * jj.position;
+          wsum += w;
+          out.sensor_mask |= 1u << v->sensor;
+        }
+        out.position = sum / wsum;
+      } else {
+        const auto score = [&](const View* v) { return m == Method::Sum ? v->conf_sum : v->facing; };
+        const View* best = *std::max_element(cand.begin(), cand.end(),
+                                             [&](const View* a, const View* b) { return score(a) < score(b); });
+        out.position = best->s.joints[j].position;
+        out.sensor_mask = 1u << best->sensor;
+      }
+      return true;
+    }
+    return false;
+  }
+
+  double measurement_sigma(const View& v, std::size_t j) const {
+    const auto& jj = v.s.joints[j];
+    const double d = (jj.position - sensor_position(v.sensor)).norm();
+    const double dist = 0.5 + 0.5 * (d / 2.0) * (d / 2.0);   // depth noise grows with the square of range
+    const double view = 1.0 + 0.75 * (1.0 - v.facing);        // seen from the side or behind: less sure
+    const double conf = jj.confidence >= kTracked ? 1.0 : 3.0;
+    return 0.03 * dist * view * conf;
+  }
+
+  void fuse_kalman(Track& tr, const std::vector<View*>& vs, std::int64_t t, skeleton::Skeleton& out) {
+    for (std::size_t j = 0; j < kJointCount; ++j) {
+      auto& f = tr.filters[j];
+      auto& oj = out.joints[j];
+      std::vector<std::pair<const View*, double>> meas;
+      for (const View* v : vs) {
+        if (v->s.joints[j].confidence >= kInferred) meas.emplace_back(v, measurement_sigma(*v, j));
+      }
+      bool tracked = false, any = false;
+      if (!f.initialised() || tr.misses[j] >= kResetAfterMisses) {
+        // Start from the confidence-weighted mean of what the sensors say.
+        Vector3d sum = Vector3d::Zero();
+        double wsum = 0, sig = 0;
+        for (const auto& [v, s] : meas) {
+          const double w = 1.0 / (s * s);
+          sum += w * v->s.joints[j].position;
+          wsum += w;
+          sig = std::max(sig, s);
+        }
+        if (wsum > 0) {
+          f.reset(sum / wsum, sig, t);
+          tr.misses[j] = 0;
+          tr.last_update_ns[j] = t;
+          for (const auto& [v, s] : meas) {
+            oj.sensor_mask |= 1u << v->sensor;
+            tracked = tracked || v->s.joints[j].confidence >= kTracked;
+          }
+          any = true;
+        }
+      } else {
+        f.predict(t);
+        for (const auto& [v, s] : meas) {
+          const Vector3d z = v->s.joints[j].position;
+          if (f.mahalanobis2(z, s) > kGate) {
+            ++stats.gated;
+            continue;
+          }
+          f.update(z, s);
+          oj.sensor_mask |= 1u << v->sensor;
+          tracked = tracked || v->s.joints[j].confidence >= kTracked;
+          any = true;
+        }
+        if (any) {
+          tr.misses[j] = 0;
+          tr.last_update_ns[j] = t;
+        } else if (!meas.empty()) {
+          ++tr.misses[j];
+        }
+      }
+      if (!f.initialised()) continue;
+      oj.position = f.position();
+      oj.confidence = tracked ? kTracked : (any || t - tr.last_update_ns[j] <= kCoastNs ? kInferred : 0.0f);
+    }
+    // Limbs keep their length: learn each from confident frames, then pull the child towards it.
+    for (std::size_t b = 0; b < std::size(kLimbs); ++b) {
+      const auto p = static_cast<std::size_t>(kLimbs[b].parent), c = static_cast<std::size_t>(kLimbs[b].child);
+      if (out.joints[p].confidence < kTracked || out.joints[c].confidence <= 0) continue;
+      const Vector3d d = out.joints[c].position - out.joints[p].position;
+      const double len = d.norm();
+      if (len < 1e-6) continue;
+      if (out.joints[c].confidence >= kTracked && tr.bone_n[b] < 300) {
+        tr.bone_sum[b] += len;
+        tr.bone_n[b] += 1;
+      }
+      if (tr.bone_n[b] < 15) continue;
+      const double target = tr.bone_sum[b] / tr.bone_n[b];
+      const Vector3d moved = out.joints[p].position + d * ((0.5 * len + 0.5 * target) / len);
+      out.joints[c].position = moved;
+      tr.filters[c].set_position(moved);
+    }
+  }
+
+  std::vector<skeleton::Skeleton> fuse(std::int64_t now) {
+    const std::int64_t t = now - opt.delay_ns;
+    // Forget streams and people that went quiet.
+    for (auto it = streams.begin(); it != streams.end();) {
+      if (it->second.samples.empty() || t - it->second.samples.back().t > opt.person_timeout_ns) it = streams.erase(it);
+      else ++it;
+    }
+    tracks.erase(std::remove_if(tracks.begin(), tracks.end(),
+                                [&](const Track& tr) { return t - tr.last_ns > opt.person_timeout_ns; }),
+                 tracks.end());
+    std::vector<View> views;
+    for (auto& [key, st] : streams) {
+      auto s = view_at(st, t);
+      if (!s) continue;
+      const auto c = skeleton::centre_of(*s);
+      if (!c) continue;
+      views.push_back({&st, key.first, std::move(*s), *c});
+    }
+    auto by_track = associate(views, t);
+    std::vector<skeleton::Skeleton> out;
+    ++frame_number;
+    for (auto& [id, vs] : by_track) {
+      Track& tr = track_by_id(id);
+      update_heading(tr, vs, opt.method == Method::Kalman);
+      skeleton::Skeleton f;
+      f.sensor_id = "fused";
+      f.person_id = id;
+      f.frame_id = "world";
+      f.stamp_ns = t;
+      f.frame_number = frame_number;
+      if (opt.method == Method::Kalman) {
+        fuse_kalman(tr, vs, t, f);
+      } else {
+        for (std::size_t j = 0; j < kJointCount; ++j) {
+          if (!fuse_joint_simple(opt.method, j, vs, f.joints[j])) {
+            f.joints[j].position = tr.last.joints[j].position;  // not seen: where it was, confidence 0
+            f.joints[j].confidence = 0;
+          }
+        }
+      }
+      if (const auto c = skeleton::centre_of(f)) tr.centre = *c;
+      tr.last_ns = t;
+      tr.last = f;
+      ++tr.frames;
+      ++stats.fused;
+      out.push_back(std::move(f));
+    }
+    return out;
+  }
+};
+
+Fuser::Fuser(FuserOptions options) : impl_(std::make_unique<Impl>()) { impl_->opt = options; }
+Fuser::~Fuser() = default;
+Fuser::Fuser(Fuser&&) noexcept = default;
+Fuser& Fuser::operator=(Fuser&&) noexcept = default;
+
+void Fuser::set_pose(const std::string& sensor, const Eigen::Isometry3d& world_from_sensor) {
+  auto& s = impl_->sensors[impl_->sensor_index(sensor)];
+  s.pose = world_from_sensor;
+  s.has_pose = true;
+}
+
+bool Fuser::has_pose(const std::string& sensor) const {
+  return std::any_of(impl_->sensors.begin(), impl_->sensors.end(),
+                     [&](const SensorInfo& s) { return s.id == sensor && s.has_pose; });
+}
+
+void Fuser::add(const skeleton::Skeleton& raw, std::int64_t t_ns) {
+  const auto i = impl_->sensor_index(raw.sensor_id);
+  auto& sensor = impl_->sensors[i];
+  sensor.last_ns = std::max(sensor.last_ns, t_ns);
+  if (!sensor.has_pose) {
+    ++impl_->stats.no_pose;
+    return;
+  }
+  if (i >= 32) return;  // the joint mask has 32 bits
+  Sample s{t_ns, raw};
+  for (auto& j : s.world.joints) j.position = sensor.pose * j.position;
+  s.world.frame_id = "world";
+  auto& st = impl_->streams[{i, raw.person_id}];
+  st.sensor = i;
+  // Samples arrive in time order from one sensor; keep a few for interpolation.
+  auto pos = std::upper_bound(st.samples.begin(), st.samples.end(), t_ns,
+                              [](std::int64_t t, const Sample& x) { return t < x.t; });
+  st.samples.insert(pos, std::move(s));
+  while (st.samples.size() > kHistory) st.samples.pop_front();
+  ++impl_->stats.added;
+}
+
+std::vector<skeleton::Skeleton> Fuser::fuse(std::int64_t t_ns) { return impl_->fuse(t_ns); }
+
+std::vector<std::string> Fuser::sensors() const {
+  std::vector<std::string> out;
+  for (const auto& s : impl_->sensors) out.push_back(s.id);
+  return out;
+}
+
+std::vector<std::string> Fuser::silent_sensors(std::int64_t t_ns) const {
+  std::vector<std::string> out;
+  for (const auto& s : impl_->sensors) {
+    if (s.last_ns != std::numeric_limits<std::int64_t>::min() && t_ns - s.last_ns > impl_->opt.sensor_timeout_ns) {
+      out.push_back(s.id);
+    }
+  }
+  return out;
+}
+
+const FuserStats& Fuser::stats() const { return impl_->stats; }
+const FuserOptions& Fuser::options() const { return impl_->opt; }
+
+}  // namespace skelgraph::fusion

@@ -1,0 +1,246 @@
+// The fusion core: the thesis's avg and sum exactly, the other methods'
+// choices, people kept apart and stable, flipped sensors corrected, silent
+// sensors reported; and on the simulator, fusion beats a single sensor.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "skelgraph/eval/metrics.hpp"
+#include "skelgraph/eval/offline.hpp"
+#include "skelgraph/fusion/fuser.hpp"
+#include "skelgraph/fusion/joint_filter.hpp"
+#include "skelgraph/sim/simulation.hpp"
+
+using namespace skelgraph;
+using skeleton::JointId;
+using Eigen::Vector3d;
+
+namespace {
+
+constexpr std::int64_t kMs = 1'000'000;
+
+// A standing person facing +z at `at` (world = sensor frame when poses are identity).
+skeleton::Skeleton person(const std::string& sensor, std::uint32_t id, const Vector3d& at, float conf = 1.0f) {
+  skeleton::Skeleton s;
+  s.sensor_id = sensor;
+  s.person_id = id;
+  const std::pair<JointId, Vector3d> layout[] = {
+      {JointId::Head, {0, 0.7, 0}},          {JointId::Neck, {0, 0.5, 0}},           {JointId::Torso, {0, 0.2, 0}},
+      {JointId::LeftShoulder, {0.2, 0.5, 0}}, {JointId::LeftElbow, {0.25, 0.2, 0}},  {JointId::LeftHand, {0.3, -0.05, 0}},
+      {JointId::RightShoulder, {-0.2, 0.5, 0}}, {JointId::RightElbow, {-0.25, 0.2, 0}}, {JointId::RightHand, {-0.3, -0.05, 0}},
+      {JointId::LeftHip, {0.1, 0, 0}},       {JointId::LeftKnee, {0.1, -0.45, 0}},   {JointId::LeftFoot, {0.1, -0.9, 0}},
+      {JointId::RightHip, {-0.1, 0, 0}},     {JointId::RightKnee, {-0.1, -0.45, 0}}, {JointId::RightFoot, {-0.1, -0.9, 0}}};
+  for (const auto& [j, p] : layout) {
+    s[j].position = at + p;
+    s[j].confidence = conf;
+  }
+  return s;
+}
+
+fusion::Fuser make(fusion::Method m, int sensors = 2) {
+  fusion::FuserOptions o;
+  o.method = m;
+  fusion::Fuser f(o);
+  for (int i = 1; i <= sensors; ++i) {
+    // Sensors 2 m in front of the origin (+z) and to the side (+x), looking at it; poses only place them.
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.translation() = i == 1 ? Vector3d(0, 1.2, 2) : Vector3d(2, 1.2, 0);
+    f.set_pose("s" + std::to_string(i), pose);
+  }
+  return f;
+}
+
+// The poses above translate: feed skeletons already minus the translation so world positions are what we say.
+skeleton::Skeleton in_sensor(skeleton::Skeleton s, const Vector3d& sensor_at) {
+  for (auto& j : s.joints) j.position -= sensor_at;
+  return s;
+}
+const Vector3d kS1(0, 1.2, 2), kS2(2, 1.2, 0);
+
+}  // namespace
+
+TEST(Fusion, MethodNamesRoundTrip) {
+  for (const auto& n : fusion::method_names()) EXPECT_EQ(fusion::method_name(*fusion::method_from_name(n)), n);
+  EXPECT_FALSE(fusion::method_from_name("median"));
+}
+
+TEST(Fusion, AvgTakesTheOnlyTrackedSensorAndAveragesWhenBothAre) {
+  auto f = make(fusion::Method::Avg);
+  auto a = person("s1", 1, {0, 1, 0});
+  auto b = person("s2", 7, {0.04, 1, 0});
+  b[JointId::LeftHand].confidence = 0.5f;  // only s1 tracks the left hand
+  b[JointId::LeftHand].position += Vector3d(0.0, 0.02, 0);
+  a[JointId::RightHand].confidence = 0.0f;  // only s2 sees the right hand
+  f.add(in_sensor(a, kS1), 0);
+  f.add(in_sensor(b, kS2), 0);
+  const auto out = f.fuse(10 * kMs);
+  ASSERT_EQ(out.size(), 1u);
+  const auto& s = out[0];
+  EXPECT_EQ(s.frame_id, "world");
+  EXPECT_NEAR(s[JointId::Head].position.x(), 0.02, 1e-9);  // mean of the two
+  EXPECT_EQ(s[JointId::Head].sensor_mask, 3u);
+  EXPECT_NEAR(s[JointId::LeftHand].position.x(), a[JointId::LeftHand].position.x(), 1e-9);  // the tracked one
+  EXPECT_EQ(s[JointId::LeftHand].sensor_mask, 1u);
+  EXPECT_NEAR(s[JointId::RightHand].position.x(), b[JointId::RightHand].position.x(), 1e-9);
+  EXPECT_EQ(s[JointId::RightHand].sensor_mask, 2u);
+  EXPECT_FLOAT_EQ(s[JointId::RightHand].confidence, 1.0f);
+}
+
+TEST(Fusion, SumTakesTheSensorWithTheHigherConfidenceSum) {
+  auto f = make(fusion::Method::Sum);
+  auto a = person("s1", 1, {0, 1, 0});
+  auto b = person("s2", 1, {0.04, 1, 0});
+  a[JointId::LeftFoot].confidence = 0.0f;  // s1's skeleton is less sure overall
+  f.add(in_sensor(a, kS1), 0);
+  f.add(in_sensor(b, kS2), 0);
+  const auto out = f.fuse(10 * kMs);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_NEAR(out[0][JointId::Head].position.x(), 0.04, 1e-9);
+  EXPECT_EQ(out[0][JointId::Head].sensor_mask, 2u);
+}
+
+TEST(Fusion, FacingPrefersTheSensorInFrontOfTheTorso) {
+  auto f = make(fusion::Method::Facing);
+  // The person faces +z: sensor 1 (at +z) is in front, sensor 2 (at +x) to the side.
+  f.add(in_sensor(person("s1", 1, {0, 1, 0}), kS1), 0);
+  f.add(in_sensor(person("s2", 1, {0.04, 1, 0}), kS2), 0);
+  const auto out = f.fuse(10 * kMs);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0][JointId::Head].sensor_mask, 1u);
+}
+
+TEST(Fusion, OldSamplesAreNotUsedAndSilentSensorsAreReported) {
+  auto f = make(fusion::Method::Avg);
+  f.add(in_sensor(person("s1", 1, {0, 1, 0}), kS1), 0);
+  f.add(in_sensor(person("s2", 1, {0, 1, 0}), kS2), 0);
+  EXPECT_EQ(f.fuse(50 * kMs).size(), 1u);
+  EXPECT_TRUE(f.fuse(150 * kMs).empty());  // older than max_age (100 ms)
+  f.add(in_sensor(person("s1", 1, {0, 1, 0}), kS1), 1500 * kMs);
+  const auto out = f.fuse(1510 * kMs);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0][JointId::Head].sensor_mask, 1u);
+  EXPECT_EQ(f.silent_sensors(1510 * kMs), std::vector<std::string>{"s2"});
+  f.add(in_sensor(person("s2", 1, {0, 1, 0}), kS2), 1600 * kMs);  // it comes back
+  EXPECT_TRUE(f.silent_sensors(1600 * kMs).empty());
+}
+
+TEST(Fusion, SamplesWithoutAPoseAreIgnoredAndCounted) {
+  auto f = make(fusion::Method::Avg, 1);
+  f.add(person("elsewhere", 1, {0, 1, 0}), 0);
+  EXPECT_TRUE(f.fuse(1).empty());
+  EXPECT_EQ(f.stats().no_pose, 1u);
+}
+
+TEST(Fusion, InterpolatesBetweenTheSamplesAroundTheFusionTime) {
+  fusion::FuserOptions o;
+  o.method = fusion::Method::Avg;
+  o.delay_ns = 40 * kMs;
+  fusion::Fuser f(o);
+  f.set_pose("s1", Eigen::Isometry3d::Identity());
+  f.add(person("s1", 1, {0, 1, 0}), 0);
+  f.add(person("s1", 1, {0.1, 1, 0}), 40 * kMs);
+  const auto out = f.fuse(60 * kMs);  // describes t = 20 ms
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].stamp_ns, 20 * kMs);
+  EXPECT_NEAR(out[0][JointId::Torso].position.x(), 0.05, 1e-9);
+}
+
+TEST(Fusion, PeopleStayApartAndKeepTheirIdsWhenOneSensorLosesThem) {
+  auto f = make(fusion::Method::Avg);
+  std::map<double, std::uint32_t> id_at_x;
+  for (int k = 0; k < 30; ++k) {
+    const std::int64_t t = k * 33 * kMs;
+    f.add(in_sensor(person("s1", 11, {-1, 1, 0}), kS1), t);
+    f.add(in_sensor(person("s1", 12, {1, 1, 0}), kS1), t);
+    if (k < 15) {  // sensor 2 loses both people half way
+      f.add(in_sensor(person("s2", 3, {-1.02, 1, 0}), kS2), t);
+      f.add(in_sensor(person("s2", 4, {1.02, 1, 0}), kS2), t);
+    }
+    const auto out = f.fuse(t + kMs);
+    ASSERT_EQ(out.size(), 2u) << "tick " << k;
+    for (const auto& s : out) {
+      const double x = std::round(s[JointId::Torso].position.x());
+      if (k == 0) id_at_x[x] = s.person_id;
+      EXPECT_EQ(s.person_id, id_at_x.at(x)) << "tick " << k;
+      if (k < 15) {
+        EXPECT_EQ(s[JointId::Torso].sensor_mask, 3u);
+      } else if (k >= 19) {
+        EXPECT_EQ(s[JointId::Torso].sensor_mask, 1u);  // sensor 2's last samples are past max_age
+      }
+    }
+  }
+  EXPECT_NE(id_at_x.at(-1), id_at_x.at(1));
+}
+
+TEST(Fusion, KalmanCorrectsASensorThatSeesTheBack) {
+  auto f = make(fusion::Method::Kalman);
+  for (int k = 0; k < 40; ++k) {
+    const std::int64_t t = k * 33 * kMs;
+    f.add(in_sensor(person("s1", 1, {0, 1, 0}), kS1), t);
+    auto back = person("s2", 1, {0, 1, 0});
+    if (k >= 20) skeleton::swap_sides(back);  // from tick 20 sensor 2 labels left as right
+    f.add(in_sensor(back, kS2), t);
+    const auto out = f.fuse(t + kMs);
+    ASSERT_EQ(out.size(), 1u);
+    // The fused left hand stays on the person's left (+x).
+    EXPECT_GT(out[0][JointId::LeftHand].position.x(), 0.2) << "tick " << k;
+  }
+  EXPECT_GE(f.stats().flips_corrected, 20u);
+}
+
+TEST(Fusion, KalmanGatesAnOutlier) {
+  auto f = make(fusion::Method::Kalman);
+  for (int k = 0; k < 30; ++k) {
+    const std::int64_t t = k * 33 * kMs;
+    f.add(in_sensor(person("s1", 1, {0, 1, 0}), kS1), t);
+    auto b = person("s2", 1, {0, 1, 0});
+    if (k == 25) b[JointId::RightHand].position += Vector3d(0, 0, 0.8);  // a wild reading
+    f.add(in_sensor(b, kS2), t);
+    const auto out = f.fuse(t + kMs);
+    ASSERT_EQ(out.size(), 1u);
+    if (k == 25) {
+      EXPECT_LT(std::abs(out[0][JointId::RightHand].position.z()), 0.05);
+    }
+  }
+  EXPECT_GE(f.stats().gated, 1u);
+}
+
+TEST(JointFilter, ConvergesOnAMovingPointAndEstimatesItsVelocity) {
+  fusion::JointFilter kf;
+  kf.reset({0, 0, 0}, 0.05, 0);
+  for (int k = 1; k <= 60; ++k) {
+    const std::int64_t t = k * 33 * kMs;
+    kf.predict(t);
+    kf.update({0.5 * static_cast<double>(t) * 1e-9, 0, 0}, 0.01);  // 0.5 m/s along x
+  }
+  EXPECT_NEAR(kf.velocity().x(), 0.5, 0.05);
+  EXPECT_NEAR(kf.position().x(), 0.5 * 60 * 0.033, 0.01);
+}
+
+// The simulator's 360 scenario with two sensors: fusion keeps the arms far more
+// often than either sensor alone, and the filter is more accurate than the best single sensor.
+TEST(Fusion, OnTheSimulatorFusionBeatsEachSingleSensor) {
+  sim::SimConfig cfg;
+  cfg.scenario.name = "360";
+  cfg.scenario.seed = 3;
+  sim::Simulation sim(cfg);
+  std::map<std::string, Eigen::Isometry3d> poses;
+  for (const auto& s : cfg.sensors) poses[s.id] = s.world_from_sensor();
+  std::vector<eval::TimedSkeleton> events;
+  for (auto& e : sim.advance(sim.duration() + 1)) {
+    events.push_back({e.kind == sim::SimEvent::Kind::Truth ? eval::TimedSkeleton::Kind::Truth : eval::TimedSkeleton::Kind::Raw,
+                      static_cast<std::int64_t>(std::llround(e.t * 1e9)), std::move(e.skeleton)});
+  }
+  const auto r = eval::evaluate(poses, events, {});
+  std::map<std::string, const eval::StreamScore*> by;
+  for (const auto& s : r.streams) by[s.name] = &s;
+  const auto arms = [](const eval::StreamScore& s) {
+    const auto f = s.accuracy.figures();
+    return (f[3].detection_pct + f[4].detection_pct + f[5].detection_pct) / 3;
+  };
+  const double best_single_arms = std::max(arms(*by.at("sensor1")), arms(*by.at("sensor2")));
+  const double best_single_err = std::min(by.at("sensor1")->accuracy.mean_error_cm(), by.at("sensor2")->accuracy.mean_error_cm());
+  for (const char* m : {"avg", "sum"}) EXPECT_GT(arms(*by.at(m)), best_single_arms) << m;
+  EXPECT_LT(by.at("kalman")->accuracy.mean_error_cm(), 0.75 * best_single_err);
+  EXPECT_LT(by.at("kalman")->steadiness.mean_bone_sd_cm(), by.at("sensor1")->steadiness.mean_bone_sd_cm());
+}
