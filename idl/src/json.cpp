@@ -73,6 +73,10 @@ void to_json(nlohmann::json& j, const FrameRef& v) {
        {"frame_number", v.frame_number()}, {"stamp_ns", v.stamp_ns()},
        {"log_time_ns", v.log_time_ns()}};
 }
+void to_json(nlohmann::json& j, const SensorFrame& v) {
+  j = {{"sensor_id", v.sensor_id().to_string()}, {"stamp_ns", v.stamp_ns()}, {"frame_number", v.frame_number()},
+       {"people", v.people()}};
+}
 void to_json(nlohmann::json& j, const TickFrames& v) {
   j = {{"session_id", v.session_id()}, {"tick", v.tick()}, {"master_stamp_ns", v.master_stamp_ns()},
        {"frames", v.frames()}};

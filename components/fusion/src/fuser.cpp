@@ -431,6 +431,11 @@ bool Fuser::has_pose(const std::string& sensor) const {
                      [&](const SensorInfo& s) { return s.id == sensor && s.has_pose; });
 }
 
+void Fuser::heartbeat(const std::string& sensor, std::int64_t t_ns) {
+  auto& s = impl_->sensors[impl_->sensor_index(sensor)];
+  s.last_ns = std::max(s.last_ns, t_ns);
+}
+
 void Fuser::add(const skeleton::Skeleton& raw, std::int64_t t_ns) {
   const auto i = impl_->sensor_index(raw.sensor_id);
   auto& sensor = impl_->sensors[i];

@@ -12,7 +12,7 @@ TopicInfo info(const TopicDef<T>& def) {
 const std::vector<TopicInfo>& known_topics() {
   static const std::vector<TopicInfo> table = {
       info(topics::kSync),         info(topics::kSyncSession),   info(topics::kSyncControl),
-      info(topics::kSyncAck),      info(topics::kSyncClock),      info(topics::kSkeletonRaw),   info(topics::kSkeletonFused),
+      info(topics::kSyncAck),      info(topics::kSyncClock),      info(topics::kSkeletonRaw),   info(topics::kSensorFrame),   info(topics::kSkeletonFused),
       info(topics::kSkeletonTruth), info(topics::kDepth),        info(topics::kCalibration),
       info(topics::kGestureEvent), info(topics::kStatus)};
   return table;

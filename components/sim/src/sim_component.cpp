@@ -1,5 +1,7 @@
 #include "skelgraph/sim/sim_component.hpp"
 
+#include <algorithm>
+
 #include <chrono>
 #include <cmath>
 #include <sstream>
@@ -57,7 +59,13 @@ runtime::ComponentInfo SimComponent::describe() {
                               {}};
   add_sim_params(info.params);
   info.params.add_double("rate", 1.0, "speed: 1 = real time, 2 = twice as fast", 0.01, 100.0)
-      .add_bool("loop", false, "run the scenario again at the end (same seed, later clock)");
+      .add_bool("loop", false, "run the scenario again at the end (same seed, later clock)")
+      .add_string_list("publish_sensors", {}, "publish only these sensors' skeletons and poses (default: all); "
+                                              "with wall_clock_aligned, several sims can each play some sensors of one cell")
+      .add_bool("publish_truth", true, "publish ground truth")
+      .add_bool("wall_clock_aligned", false,
+                "scenario time = wall clock modulo the scenario's duration, so sims started at different times (or "
+                "restarted) agree on where the person is; implies loop");
   return info;
 }
 
@@ -65,15 +73,31 @@ SimComponent::SimComponent(runtime::Context& ctx, const runtime::Params& params)
     : Component(ctx),
       config_(sim_config_from(params)),
       rate_(params.get<double>("rate")),
-      loop_(params.get<bool>("loop")),
+      loop_(params.get<bool>("loop") || params.get<bool>("wall_clock_aligned")),
       truth_pub_(ctx, runtime::topics::kSkeletonTruth),
       raw_pub_(ctx, runtime::topics::kSkeletonRaw),
+      frame_pub_(ctx, runtime::topics::kSensorFrame),
       pose_pub_(ctx, runtime::topics::kCalibration) {
   sim_ = std::make_unique<Simulation>(config_);  // checks the configuration before the graph starts
+  publish_sensors_ = params.get<std::vector<std::string>>("publish_sensors");
+  for (const auto& id : publish_sensors_) {
+    if (std::none_of(config_.sensors.begin(), config_.sensors.end(), [&](const SensorConfig& c) { return c.id == id; })) {
+      throw std::invalid_argument("publish_sensors: no sensor '" + id + "' in this cell");
+    }
+  }
+  publish_truth_ = params.get<bool>("publish_truth");
+  aligned_ = params.get<bool>("wall_clock_aligned");
+}
+
+bool SimComponent::publishes(std::size_t sensor) const {
+  return publish_sensors_.empty() || std::find(publish_sensors_.begin(), publish_sensors_.end(),
+                                               config_.sensors[sensor].id) != publish_sensors_.end();
 }
 
 void SimComponent::publish_poses() {
-  for (const auto& s : config_.sensors) {
+  for (std::size_t i = 0; i < config_.sensors.size(); ++i) {
+    if (!publishes(i)) continue;
+    const auto& s = config_.sensors[i];
     skeleton::SensorPose p;
     p.sensor_id = s.id;
     p.pose = s.world_from_sensor();
@@ -86,6 +110,14 @@ void SimComponent::publish_poses() {
 void SimComponent::on_start() {
   start_mono_ns_ = runtime::Context::monotonic_ns();
   config_.epoch_ns = runtime::Context::now_ns();
+  config_.emit_frames = true;
+  if (aligned_) {
+    const auto period = static_cast<std::int64_t>(std::llround(sim_->duration() * 1e9 / rate_));
+    const auto into = config_.epoch_ns % period;
+    config_.epoch_ns -= into;
+    start_mono_ns_ -= into;
+    skip_before_s_ = static_cast<double>(into) * 1e-9 * rate_;
+  }
   sim_ = std::make_unique<Simulation>(config_);
   publish_poses();
   timer_ = ctx_.executor().every(std::chrono::milliseconds(5), [this] { tick(); }, true);
@@ -94,9 +126,20 @@ void SimComponent::on_start() {
 void SimComponent::tick() {
   const double t = static_cast<double>(runtime::Context::monotonic_ns() - start_mono_ns_) * 1e-9 * rate_ - loop_offset_s_;
   for (const auto& e : sim_->advance(t)) {
+    if (e.t + loop_offset_s_ < skip_before_s_) continue;
     if (e.kind == SimEvent::Kind::Truth) {
+      if (!publish_truth_) continue;
       truth_pub_.publish(skeleton::to_msg(e.skeleton));
       ++truth_published_;
+    } else if (!publishes(e.sensor)) {
+      continue;
+    } else if (e.kind == SimEvent::Kind::Frame) {
+      msg::SensorFrame f;
+      f.sensor_id(e.skeleton.sensor_id);
+      f.stamp_ns(e.skeleton.stamp_ns);
+      f.frame_number(e.skeleton.frame_number);
+      f.people(e.people);
+      frame_pub_.publish(f);
     } else {
       raw_pub_.publish(skeleton::to_msg(e.skeleton));
       ++raw_published_;

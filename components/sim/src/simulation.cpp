@@ -84,9 +84,11 @@ void Simulation::emit_raw(std::size_t i, double t, std::vector<SimEvent>& out) {
   std::vector<skeleton::Skeleton> truths;
   for (const auto& a : scene.actors) truths.push_back(forward_kinematics(body_, a.pose));
   ++st.frame;
+  std::uint32_t people = 0;
   for (std::size_t p = 0; p < st.trackers.size(); ++p) {
     auto s = st.trackers[p]->observe(t, scene, p, truths);
     if (!s) continue;
+    ++people;
     SimEvent e;
     e.kind = SimEvent::Kind::Raw;
     e.t = t;
@@ -96,6 +98,17 @@ void Simulation::emit_raw(std::size_t i, double t, std::vector<SimEvent>& out) {
     s->frame_number = st.frame;
     e.skeleton = std::move(*s);
     out.push_back(std::move(e));
+  }
+  if (cfg_.emit_frames) {
+    SimEvent f;
+    f.kind = SimEvent::Kind::Frame;
+    f.t = t;
+    f.sensor = i;
+    f.people = people;
+    f.skeleton.sensor_id = st.config.id;
+    f.skeleton.stamp_ns = sensor_stamp_ns(st.config, t, cfg_.epoch_ns);
+    f.skeleton.frame_number = st.frame;
+    out.push_back(std::move(f));
   }
 }
 

@@ -26,6 +26,7 @@ void to_json(nlohmann::json& j, const SyncAck& v);
 void to_json(nlohmann::json& j, const ClockOffset& v);
 void to_json(nlohmann::json& j, const FrameRef& v);
 void to_json(nlohmann::json& j, const TickFrames& v);
+void to_json(nlohmann::json& j, const SensorFrame& v);
 void to_json(nlohmann::json& j, const SensorPose& v);
 void to_json(nlohmann::json& j, const CameraIntrinsics& v);
 void to_json(nlohmann::json& j, const DepthFrame& v);

@@ -62,6 +62,9 @@ class Fuser {
   void set_pose(const std::string& sensor, const Eigen::Isometry3d& world_from_sensor);
   bool has_pose(const std::string& sensor) const;
 
+  // The sensor delivered a frame at t_ns (whether or not it saw anyone): it is alive.
+  void heartbeat(const std::string& sensor, std::int64_t t_ns);
+
   // A raw skeleton in its sensor's frame, received at t_ns.
   void add(const skeleton::Skeleton& raw, std::int64_t t_ns);
 

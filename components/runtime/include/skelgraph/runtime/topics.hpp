@@ -40,6 +40,8 @@ inline const TopicDef<msg::SyncAck> kSyncAck{"skelgraph/sync_ack", {R::Reliable,
 // Each host's clock offset, from the sync master; late joiners (recorders) get the latest per host.
 inline const TopicDef<msg::ClockOffset> kSyncClock{"skelgraph/sync/clock", {R::Reliable, D::TransientLocal, 32}};
 inline const TopicDef<msg::Skeleton> kSkeletonRaw{"skelgraph/skeleton/raw", {R::BestEffort, D::Volatile, 5}};
+// One per delivered sensor frame (people seen or not): the sensor is alive.
+inline const TopicDef<msg::SensorFrame> kSensorFrame{"skelgraph/sensor/frame", {R::BestEffort, D::Volatile, 5}};
 inline const TopicDef<msg::Skeleton> kSkeletonFused{"skelgraph/skeleton/fused", {R::BestEffort, D::Volatile, 5}};
 inline const TopicDef<msg::Skeleton> kSkeletonTruth{"skelgraph/skeleton/truth", {R::Reliable, D::Volatile, 64}};
 inline const TopicDef<msg::DepthFrame> kDepth{"skelgraph/depth", {R::BestEffort, D::Volatile, 2}};

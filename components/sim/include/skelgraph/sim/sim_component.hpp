@@ -30,9 +30,14 @@ class SimComponent final : public runtime::Component {
   bool loop_ = false;
   std::unique_ptr<Simulation> sim_;
   runtime::Publisher<msg::Skeleton> truth_pub_, raw_pub_;
+  runtime::Publisher<msg::SensorFrame> frame_pub_;
   runtime::Publisher<msg::SensorPose> pose_pub_;
   runtime::TimerHandle timer_;
   std::int64_t start_mono_ns_ = 0;
+  std::vector<std::string> publish_sensors_;  // empty: all
+  bool publish_truth_ = true, aligned_ = false;
+  double skip_before_s_ = 0.0;  // aligned start: events before this were "published" before we started
+  bool publishes(std::size_t sensor) const;
   double loop_offset_s_ = 0.0;  // world time at which the current run started
   std::uint64_t truth_published_ = 0, raw_published_ = 0, runs_completed_ = 0;
   bool finished_ = false;

@@ -24,15 +24,18 @@ struct SimConfig {
   double noise_scale = 1.0;
   double truth_rate_hz = 30.0;
   std::int64_t epoch_ns = 0;     // world clock at t = 0
+  bool emit_frames = false;      // also a Frame event for every sensor frame (seen anyone or not)
 };
 
 struct SimEvent {
-  enum class Kind { Truth, Raw };
+  enum class Kind { Truth, Raw, Frame };
   Kind kind = Kind::Truth;
   double t = 0.0;                  // world time, s since the start
   std::size_t sensor = 0;          // Raw: index into the configuration's sensors
   std::uint32_t actor = 0;         // the true person (Scene actor person_id)
-  skeleton::Skeleton skeleton;     // Truth: world frame; Raw: sensor frame, stamped on the sensor clock
+  skeleton::Skeleton skeleton;     // Truth: world frame; Raw: sensor frame, stamped on the sensor clock;
+                                   // Frame: only sensor_id, stamp_ns and frame_number
+  std::uint32_t people = 0;        // Frame: skeletons the sensor reported in it
 };
 
 class Simulation {

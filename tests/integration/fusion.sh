@@ -1,0 +1,69 @@
+#!/usr/bin/env bash
+# Fusion live, and a sensor host dropping out: two simulators play the two
+# sensors of one cell (in step with the wall clock), the fusion component fuses
+# them; the second sensor's process is killed and fusion goes on at full rate
+# with its status DEGRADED; a new process for that sensor brings it back.
+source "$(dirname "$0")/lib.sh"
+
+cam() {  # cam NAME SENSOR [extra -p ...]
+  local name=$1 sensor=$2; shift 2
+  "$SKELGRAPH" run sim --name "$name" -p scenario=walk -p sensor_count=2 -p wall_clock_aligned=true \
+    -p publish_sensors="$sensor" "$@" --duration 60 >/dev/null 2>"$WORK/$name.err" &
+}
+cam cam1 sensor1
+cam1=$!
+cam cam2 sensor2 -p publish_truth=false
+cam2=$!
+"$SKELGRAPH" run fusion --name fusion -p method=kalman -p sensor_timeout_ms=500 --duration 60 --json \
+  >"$WORK/fusion.json" 2>"$WORK/fusion.err" &
+fusion=$!
+
+# status STATE: waits (bounded) until the fusion component reports STATE; saves the status.
+status() {
+  for _ in $(seq 40); do
+    { timeout 5 "$SKELGRAPH" topic echo skelgraph/status --json --count 20 --timeout 3 2>/dev/null || true; } |
+      python3 -c '
+import json, sys
+for line in sys.stdin:
+    d = json.loads(line)["data"]
+    if d["component_name"] == "fusion" and d["state"] == sys.argv[1]:
+        print(json.dumps(d)); sys.exit(0)
+sys.exit(1)' "$1" >"$WORK/status_$1.json" && return 0
+  done
+  return 1
+}
+# rate: the fused output's rate over 3 s.
+rate() { "$SKELGRAPH" topic hz skelgraph/skeleton/fused --window 3 --json --timeout 10 >"$WORK/hz_$1.json" && json_get "$WORK/hz_$1.json" 'round(d["rate_hz"], 1)'; }
+
+status OK || fail "fusion never OK: $(tail -5 "$WORK/fusion.err")"
+timeout 10 "$SKELGRAPH" topic echo skelgraph/skeleton/fused --json --count 30 --timeout 5 >"$WORK/fused.jsonl"
+python3 - "$WORK/fused.jsonl" <<'PY' || fail "fused skeletons wrong"
+import json, sys
+rows = [json.loads(l)["data"] for l in open(sys.argv[1])]
+assert all(r["frame_id"] == "world" and r["sensor_id"] == "fused" for r in rows)
+masks = [max(j["sensor_mask"] for j in r["joints"]) for r in rows]
+assert max(masks) == 3, masks   # both sensors contribute
+PY
+before=$(rate both)
+python3 -c "import sys; sys.exit(0 if 27 <= float(sys.argv[1]) <= 33 else 1)" "$before" || fail "fused rate with both sensors: $before Hz"
+ok "fusing two sensor processes: $before Hz, both sensors in the joints"
+
+kill -KILL "$cam2"
+wait "$cam2" 2>/dev/null || true
+status DEGRADED || fail "fusion did not flag the silent sensor: $(tail -5 "$WORK/fusion.err")"
+json_check "$WORK/status_DEGRADED.json" '"sensor2" in d["message"]'
+during=$(rate dropped)
+python3 -c "import sys; sys.exit(0 if 27 <= float(sys.argv[1]) <= 33 else 1)" "$during" || fail "fused rate without sensor2: $during Hz"
+ok "sensor2's process killed: DEGRADED ($(json_get "$WORK/status_DEGRADED.json" 'd["message"]')), still $during Hz"
+
+cam cam2b sensor2 -p publish_truth=false
+cam2b=$!
+status OK || fail "fusion did not take sensor2 back: $(tail -5 "$WORK/fusion.err")"
+after=$(rate back)
+ok "sensor2 back: OK again, $after Hz"
+
+kill -INT "$fusion" "$cam1" "$cam2b"
+wait "$fusion" || fail "fusion: $(tail -5 "$WORK/fusion.err")"
+json_check "$WORK/fusion.json" 'd["components"][0]["details"]["dropouts"] == 1 and d["components"][0]["details"]["rejoins"] == 1'
+ok "fusion report: $(json_get "$WORK/fusion.json" 'd["components"][0]["summary"]')"
+echo "fusion: all checks passed"
