@@ -14,6 +14,8 @@ cam cam1 sensor1
 cam1=$!
 cam cam2 sensor2 -p publish_truth=false
 cam2=$!
+"$SKELGRAPH" bag record --now --label cell --dir "$WORK/rec" --duration 10 >/dev/null 2>"$WORK/rec.err" &
+rec=$!
 "$SKELGRAPH" run fusion --name fusion -p method=kalman -p sensor_timeout_ms=500 --duration 60 --json \
   >"$WORK/fusion.json" 2>"$WORK/fusion.err" &
 fusion=$!
@@ -48,6 +50,28 @@ before=$(rate both)
 python3 -c "import sys; sys.exit(0 if 27 <= float(sys.argv[1]) <= 33 else 1)" "$before" || fail "fused rate with both sensors: $before Hz"
 ok "fusing two sensor processes: $before Hz, both sensors in the joints"
 
+wait "$rec" || fail "recorder: $(tail -3 "$WORK/rec.err")"
+# The recording of both sensor processes, fused and scored offline.
+cell=$(ls "$WORK"/rec/cell_*.mcap)
+"$SKELGRAPH" eval recording "$cell" --json >"$WORK/eval.json" || fail "eval recording"
+"$SKELGRAPH" fuse "$cell" --out "$WORK/fused.mcap" --method avg,kalman --json >"$WORK/fuse.json" || fail "fuse"
+"$SKELGRAPH" bag info "$WORK/fused.mcap" --json >"$WORK/fused_info.json"
+python3 - "$WORK/eval.json" "$WORK/fuse.json" "$WORK/fused_info.json" <<'PY' || fail "offline fusion of the recording: $(cat "$WORK/eval.json")"
+import json, sys
+ev, fu, info = (json.load(open(p)) for p in sys.argv[1:4])
+assert ev["has_truth"] and ev["ticks"] > 100, ev["ticks"]
+s = {x["stream"]: x for x in ev["streams"]}
+assert set(s) == {"sensor1", "sensor2", "avg", "sum", "facing", "weighted", "kalman"}, set(s)
+shoulders = lambda k: s[k]["groups"]["Shoulders"]["detection_pct"]
+for m in ("avg", "sum", "kalman"):
+    assert shoulders(m) >= max(shoulders("sensor1"), shoulders("sensor2")) - 0.5, (m, shoulders(m))
+    assert s[m]["mean_error_cm"] < 15, (m, s[m]["mean_error_cm"])
+per = info["skeletons_per_sensor"]
+assert per["skelgraph/skeleton/fused fused_avg"] == fu["methods"]["avg"]["ticks_with_output"] > 100, (per, fu)
+assert info["valid"]
+print({k: round(v["mean_error_cm"], 1) for k, v in s.items()})
+PY
+ok "recording fused offline: eval and fuse agree, $(json_get "$WORK/fuse.json" 'd["fused"]') fused skeletons written"
 kill -KILL "$cam2"
 wait "$cam2" 2>/dev/null || true
 status DEGRADED || fail "fusion did not flag the silent sensor: $(tail -5 "$WORK/fusion.err")"

@@ -54,5 +54,6 @@ void add_components_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_sim_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_bag_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_eval_command(CLI::App& app, GlobalOptions& g, Action& run);
+void add_fuse_command(CLI::App& app, GlobalOptions& g, Action& run);
 
 }  // namespace skelgraph::cli

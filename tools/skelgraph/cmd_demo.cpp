@@ -26,6 +26,10 @@ components:
     params:
       scenario: point
       loop: true
+  - name: fusion
+    type: fusion
+    params:
+      method: kalman
 )";
 
 }  // namespace
@@ -36,7 +40,7 @@ void add_demo_command(CLI::App& app, GlobalOptions& g, Action& run) {
     bool json = false;
   };
   auto o = std::make_shared<Opts>();
-  auto* cmd = app.add_subcommand("demo", "Run the demo graph (sync master + monitor + simulated cell) and print what it saw");
+  auto* cmd = app.add_subcommand("demo", "Run the demo graph (sync master + monitor + simulated cell + fusion) and print what it saw");
   cmd->add_option("--duration", o->duration, "seconds to run")->check(kPositive);
   cmd->add_flag("--json", o->json, "print the report as JSON on stdout");
   add_dds_options(*cmd, g);
@@ -48,7 +52,7 @@ void add_demo_command(CLI::App& app, GlobalOptions& g, Action& run) {
       RunOptions ro;
       ro.duration_s = o->duration;
       ro.json = o->json;
-      if (!o->json) std::printf("skelgraph demo: sync master + monitor + simulated cell on DDS domain %d (profile %s) for %.1f s\n",
+      if (!o->json) std::printf("skelgraph demo: sync master + monitor + simulated cell + fusion on DDS domain %d (profile %s) for %.1f s\n",
                   make_config(g, &spec).domain, make_config(g, &spec).profile.c_str(), o->duration);
       return run_graph(registry, make_config(g, &spec), components, ro,
                        [o](runtime::Graph& graph, nlohmann::json& report) {

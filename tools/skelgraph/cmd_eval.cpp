@@ -12,6 +12,11 @@
 
 #include "cli.hpp"
 #include "skelgraph/eval/offline.hpp"
+#include "skelgraph/mcap/mcap.hpp"
+#include "skelgraph/msg/cdr.hpp"
+#include "skelgraph/recording/bag.hpp"
+#include "skelgraph/runtime/topics.hpp"
+#include "skelgraph/skeleton/skeleton_msg.hpp"
 #include "skelgraph/sim/sim_component.hpp"
 #include "skelgraph/sim/simulation.hpp"
 
@@ -119,7 +124,165 @@ int eval_sim(const SimEvalOptions& o) {
   return 0;
 }
 
+// A recording's raw skeletons, truth (both at their log time, the recorder's
+// clock) and sensor poses (the latest per sensor in the file).
+struct RecordingInputs {
+  std::map<std::string, Eigen::Isometry3d> poses;
+  std::vector<eval::TimedSkeleton> events;
+  std::uint64_t raw = 0, truth = 0;
+};
+
+RecordingInputs read_recording(const std::string& file) {
+  RecordingInputs in;
+  try {
+    const mcap::Reader reader(file);
+    reader.for_each_message([&](const mcap::Channel& ch, const mcap::Schema* schema, const mcap::Message& m) {
+      if (schema == nullptr) return;
+      const auto* bytes = reinterpret_cast<const std::uint8_t*>(m.data.data());
+      if (schema->name == msg::MessageTraits<msg::SensorPose>::name && ch.topic == runtime::topics::kCalibration.name) {
+        const auto p = skeleton::from_msg(msg::from_cdr<msg::SensorPose>(bytes, m.data.size()));
+        if (p.frame_id == "world") in.poses[p.sensor_id] = p.pose;
+      } else if (schema->name == msg::MessageTraits<msg::Skeleton>::name) {
+        const bool raw = ch.topic == runtime::topics::kSkeletonRaw.name;
+        const bool truth = ch.topic == runtime::topics::kSkeletonTruth.name;
+        if (!raw && !truth) return;
+        in.events.push_back({raw ? eval::TimedSkeleton::Kind::Raw : eval::TimedSkeleton::Kind::Truth,
+                             static_cast<std::int64_t>(m.log_time),
+                             skeleton::from_msg(msg::from_cdr<msg::Skeleton>(bytes, m.data.size()))});
+        ++(raw ? in.raw : in.truth);
+      }
+    });
+  } catch (const mcap::McapError& e) {
+    throw UsageError(e.what());
+  }
+  std::stable_sort(in.events.begin(), in.events.end(),
+                   [](const eval::TimedSkeleton& a, const eval::TimedSkeleton& b) { return a.t_ns < b.t_ns; });
+  if (in.raw == 0) throw UsageError(file + ": no raw skeletons on " + runtime::topics::kSkeletonRaw.name);
+  for (const auto& e : in.events) {
+    if (e.kind == eval::TimedSkeleton::Kind::Raw && !in.poses.count(e.skeleton.sensor_id)) {
+      throw UsageError(file + ": no pose of sensor '" + e.skeleton.sensor_id + "' on " +
+                       runtime::topics::kCalibration.name + " (calibrate it, or record the calibration topic)");
+    }
+  }
+  return in;
+}
+
+struct FileOptions {
+  std::string file, out;
+  std::vector<std::string> methods;
+  double delay_ms = 0, max_age_ms = 100;
+  bool json = false;
+};
+
+eval::OfflineOptions offline_options(const FileOptions& o) {
+  eval::OfflineOptions eo;
+  if (!o.methods.empty()) {
+    eo.methods.clear();
+    for (const auto& m : o.methods) eo.methods.push_back(*fusion::method_from_name(m));
+  }
+  eo.fuser.delay_ns = static_cast<std::int64_t>(o.delay_ms * 1e6);
+  eo.fuser.max_age_ns = static_cast<std::int64_t>(o.max_age_ms * 1e6);
+  return eo;
+}
+
+// skelgraph eval FILE: single sensors and every method, against the truth in the
+// recording if it has one; bone-length steadiness and completeness either way.
+int eval_file(const FileOptions& o) {
+  const auto in = read_recording(o.file);
+  const auto r = eval::evaluate(in.poses, in.events, offline_options(o));
+  nlohmann::json streams = nlohmann::json::array();
+  for (const auto& s : r.streams) streams.push_back(stream_json(s));
+  if (o.json) {
+    std::printf("%s\n", nlohmann::json{{"file", o.file}, {"has_truth", r.has_truth}, {"ticks", r.ticks},
+                                       {"raw_skeletons", in.raw}, {"truth_skeletons", in.truth}, {"streams", streams}}
+                            .dump(2)
+                            .c_str());
+  } else {
+    std::printf("## %s\n\n%llu raw skeletons from %zu sensor(s), %llu truth skeletons, %llu output ticks (30 Hz)\n",
+                o.file.c_str(), static_cast<unsigned long long>(in.raw), in.poses.size(),
+                static_cast<unsigned long long>(in.truth), static_cast<unsigned long long>(r.ticks));
+    if (!r.has_truth) std::printf("No ground truth in the recording: detection and error columns are empty; "
+                                  "upper-body completeness and bone-length SD need none.\n");
+    print_table(o.file, r);
+  }
+  return 0;
+}
+
+// skelgraph fuse IN --out OUT: the recording with fused skeletons added on
+// skelgraph/skeleton/fused (sensor_id "fused", or "fused_<method>" for several).
+int fuse_file(const FileOptions& o) {
+  const auto in = read_recording(o.file);
+  const auto eo = offline_options(o);
+  std::vector<std::pair<std::int64_t, skeleton::Skeleton>> fused;
+  const auto r = eval::evaluate(in.poses, in.events, [&] { auto x = eo; x.singles = false; return x; }(),
+                                [&](fusion::Method m, const skeleton::Skeleton& s) {
+                                  auto f = s;
+                                  f.sensor_id = eo.methods.size() == 1 ? "fused" : std::string("fused_") + fusion::method_name(m);
+                                  fused.emplace_back(s.stamp_ns + eo.fuser.delay_ns, std::move(f));
+                                });
+  std::stable_sort(fused.begin(), fused.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::uint64_t copied = 0;
+  try {
+    const mcap::Reader reader(o.file);
+    recording::BagWriter bag(o.out);
+    std::size_t next = 0;
+    const auto flush_until = [&](std::uint64_t t) {
+      for (; next < fused.size() && static_cast<std::uint64_t>(std::max<std::int64_t>(0, fused[next].first)) <= t; ++next) {
+        const auto at = static_cast<std::uint64_t>(std::max<std::int64_t>(0, fused[next].first));
+        bag.write(runtime::topics::kSkeletonFused.name, skeleton::to_msg(fused[next].second), at, at);
+      }
+    };
+    reader.for_each_message([&](const mcap::Channel& ch, const mcap::Schema*, const mcap::Message& m) {
+      if (ch.topic == runtime::topics::kSkeletonFused.name) return;  // replaced
+      flush_until(m.log_time);
+      const auto type = ch.metadata.count("dds_type") ? ch.metadata.at("dds_type") : std::string();
+      const bool keyed = ch.metadata.count("keyed") && ch.metadata.at("keyed") == "true";
+      bag.write_cdr(ch.topic, type, keyed, m.data, m.log_time, m.publish_time);
+      ++copied;
+    });
+    flush_until(UINT64_MAX);
+    bag.close();
+  } catch (const mcap::McapError& e) {
+    throw UsageError(e.what());
+  }
+  nlohmann::json per = nlohmann::json::object();
+  for (std::size_t i = 0; i < r.streams.size(); ++i) {
+    per[r.streams[i].name] = {{"ticks_with_output", r.streams[i].with_output},
+                              {"flips_corrected", r.fuser_stats[i].flips_corrected},
+                              {"gated", r.fuser_stats[i].gated}};
+  }
+  if (o.json) {
+    std::printf("%s\n", nlohmann::json{{"in", o.file}, {"out", o.out}, {"copied", copied}, {"fused", fused.size()},
+                                       {"ticks", r.ticks}, {"methods", per}}
+                            .dump(2)
+                            .c_str());
+  } else {
+    std::printf("%s: %zu fused skeletons (%s) added to %llu messages of %s\n", o.out.c_str(), fused.size(),
+                per.dump().c_str(), static_cast<unsigned long long>(copied), o.file.c_str());
+  }
+  return 0;
+}
+
 }  // namespace
+
+void add_fuse_command(CLI::App& app, GlobalOptions&, Action& run) {
+  auto o = std::make_shared<FileOptions>();
+  auto* f = app.add_subcommand("fuse", "Fuse a recording's raw skeletons offline (as the fusion component would live)");
+  f->add_option("file", o->file, "MCAP recording with skelgraph/skeleton/raw and skelgraph/calibration")
+      ->required()
+      ->check(CLI::ExistingFile);
+  f->add_option("--out", o->out, "MCAP file to write: the input plus skelgraph/skeleton/fused")->required();
+  f->add_option("--method", o->methods, "fusion method(s); several: sensor_id fused_<method> each (default kalman)")
+      ->delimiter(',')
+      ->check(CLI::IsMember(fusion::method_names()));
+  f->add_option("--delay-ms", o->delay_ms, "fuse this far behind the newest data")->check(kNonNegative);
+  f->add_option("--max-age-ms", o->max_age_ms, "samples older than this are not fused")->check(kPositive);
+  f->add_flag("--json", o->json, "machine-readable summary");
+  f->callback([o, &run] {
+    if (o->methods.empty()) o->methods = {"kalman"};
+    run = [o] { return fuse_file(*o); };
+  });
+}
 
 void add_eval_command(CLI::App& app, GlobalOptions&, Action& run) {
   auto* ev = app.add_subcommand("eval", "Score single sensors and fusion methods against ground truth");
@@ -135,6 +298,19 @@ void add_eval_command(CLI::App& app, GlobalOptions&, Action& run) {
   s->add_option("--max-age-ms", o->max_age_ms, "samples older than this are not fused")->check(kPositive);
   s->add_flag("--json", o->json, "machine-readable results");
   s->callback([o, &run] { run = [o] { return eval_sim(*o); }; });
+
+  auto fo = std::make_shared<FileOptions>();
+  auto* r = ev->add_subcommand("recording", "A recording's single sensors and every fusion method (truth if recorded)");
+  r->add_option("file", fo->file, "MCAP recording with skelgraph/skeleton/raw, skelgraph/calibration (and truth)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  r->add_option("--methods", fo->methods, "fusion methods (default: all)")
+      ->delimiter(',')
+      ->check(CLI::IsMember(fusion::method_names()));
+  r->add_option("--delay-ms", fo->delay_ms, "fuse this far behind the newest data")->check(kNonNegative);
+  r->add_option("--max-age-ms", fo->max_age_ms, "samples older than this are not fused")->check(kPositive);
+  r->add_flag("--json", fo->json, "machine-readable results");
+  r->callback([fo, &run] { run = [fo] { return eval_file(*fo); }; });
 }
 
 }  // namespace skelgraph::cli
