@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -11,6 +12,8 @@
 #include <nlohmann/json.hpp>
 
 #include "cli.hpp"
+#include "eval_sim.hpp"
+#include "report.hpp"
 #include "skelgraph/eval/offline.hpp"
 #include "skelgraph/mcap/mcap.hpp"
 #include "skelgraph/msg/cdr.hpp"
@@ -57,71 +60,84 @@ void print_table(const std::string& title, const eval::OfflineResult& r) {
   }
 }
 
-struct SimEvalOptions {
-  std::vector<std::string> params, scenarios{"walk", "360", "hide", "box", "occ", "sit", "arms"}, methods;
-  double delay_ms = 0, max_age_ms = 100;
-  bool json = false;
-};
-
-int eval_sim(const SimEvalOptions& o) {
-  runtime::ParamSchema schema;
-  sim::add_sim_params(schema);
-  eval::OfflineOptions eo;
-  if (!o.methods.empty()) {
-    eo.methods.clear();
-    for (const auto& m : o.methods) eo.methods.push_back(*fusion::method_from_name(m));
-  }
-  eo.fuser.delay_ns = static_cast<std::int64_t>(o.delay_ms * 1e6);
-  eo.fuser.max_age_ns = static_cast<std::int64_t>(o.max_age_ms * 1e6);
-  nlohmann::json out = nlohmann::json::array();
-  if (!o.json) {
-    std::printf("## Fusion against ground truth (simulator)\n\nDetection: %% of output ticks (30 Hz) a joint is reported "
-                "with confidence 1; error: mean distance to truth over those, cm. Singles: each sensor alone, on the same "
-                "ticks. Fusion delay %.0f ms, max sample age %.0f ms.\n",
-                o.delay_ms, o.max_age_ms);
-  }
-  for (const auto& scenario : o.scenarios) {
-    sim::SimConfig cfg;
-    try {
-      std::vector<runtime::RawParam> raw;
-      for (const auto& p : o.params) raw.push_back(runtime::parse_param_assignment(p, "--param " + p));
-      raw.push_back({"scenario", scenario, "--scenarios"});
-      cfg = sim::sim_config_from(schema.resolve(raw, "eval sim"));
-      sim::Simulation probe(cfg);
-    } catch (const runtime::ParamError& e) {
-      throw UsageError(e.what());
-    } catch (const std::invalid_argument& e) {
-      throw UsageError(e.what());
+// One scenario's part of the HTML report: its table, error over time, the
+// traced joint's coordinates against truth, and when the hands were tracked.
+// Every figure is also written as its own SVG file next to the report.
+std::string report_section(const std::string& dir, const std::string& name, const std::string& title,
+                           const eval::OfflineResult& r, const char* joint) {
+  std::ostringstream h;
+  h << "<h2>" << report::html_escape(title) << "</h2>\n<table><tr><th>stream</th>";
+  for (const auto* g : eval::group_names()) h << "<th>" << g << " det %</th><th>" << g << " err cm</th>";
+  h << "<th>mean err cm</th><th>upper body %</th><th>bone SD cm</th></tr>\n";
+  for (const auto& s : r.streams) {
+    h << "<tr><td>" << report::html_escape(s.name) << "</td>";
+    char b[64];
+    for (const auto& g : s.accuracy.figures()) {
+      std::snprintf(b, sizeof b, "<td>%.1f</td><td>%.1f</td>", g.detection_pct, g.error_cm);
+      h << b;
     }
-    sim::Simulation sim(cfg);
-    std::map<std::string, Eigen::Isometry3d> poses;
-    for (const auto& s : cfg.sensors) poses[s.id] = s.world_from_sensor();
-    std::vector<eval::TimedSkeleton> events;
-    for (auto& e : sim.advance(sim.duration() + 1.0)) {
-      const auto t = cfg.epoch_ns + static_cast<std::int64_t>(std::llround(e.t * 1e9));
-      events.push_back({e.kind == sim::SimEvent::Kind::Truth ? eval::TimedSkeleton::Kind::Truth
-                                                              : eval::TimedSkeleton::Kind::Raw,
-                        t, std::move(e.skeleton)});
-    }
-    if (!o.json) std::fprintf(stderr, "\revaluating %s (%zu events)...      ", scenario.c_str(), events.size());
-    const auto r = eval::evaluate(poses, events, eo);
-    if (!o.json) std::fprintf(stderr, "\r%50s\r", "");
-    nlohmann::json streams = nlohmann::json::array();
-    for (const auto& s : r.streams) streams.push_back(stream_json(s));
-    out.push_back({{"scenario", scenario}, {"sensors", cfg.sensors.size()}, {"profile", cfg.profile},
-                   {"seed", cfg.scenario.seed}, {"ticks", r.ticks}, {"streams", streams}});
-    if (!o.json) {
-      print_table(scenario + " (" + std::to_string(cfg.sensors.size()) + " sensors, " + cfg.profile + ", seed " +
-                      std::to_string(cfg.scenario.seed) + ")",
-                  r);
-    }
+    std::snprintf(b, sizeof b, "<td><b>%.1f</b></td><td>%.1f</td><td>%.2f</td></tr>\n", s.accuracy.mean_error_cm(),
+                  s.steadiness.upper_body_complete_pct(), s.steadiness.mean_bone_sd_cm());
+    h << b;
   }
-  if (o.json) {
-    std::printf("%s\n", nlohmann::json{{"delay_ms", o.delay_ms}, {"max_age_ms", o.max_age_ms}, {"scenarios", out}}
-                            .dump(2)
-                            .c_str());
+  h << "</table>\n";
+  if (r.streams.empty() || r.streams.front().trace.empty()) return h.str();
+  const double t0 = static_cast<double>(r.streams.front().trace.front().t_ns);
+  const auto secs = [&](const eval::StreamScore& s) {
+    std::vector<double> x;
+    for (const auto& p : s.trace) x.push_back((static_cast<double>(p.t_ns) - t0) * 1e-9);
+    return x;
+  };
+  const auto write = [&](const std::string& file, const std::string& svg) {
+    std::ofstream out(std::filesystem::path(dir) / file);
+    out << svg;
+    if (!out.flush()) throw std::runtime_error("cannot write " + (std::filesystem::path(dir) / file).string());
+    h << "<figure>" << svg << "<figcaption>" << report::html_escape(file) << "</figcaption></figure>\n";
+  };
+  std::vector<report::Series> err;
+  for (const auto& s : r.streams) {
+    report::Series se{s.name, secs(s), {}};
+    for (const auto& p : s.trace) {
+      double sum = 0;
+      int n = 0;
+      for (double e : p.error_cm) {
+        if (std::isfinite(e)) sum += e, ++n;
+      }
+      se.y.push_back(n > 0 ? sum / n : std::nan(""));
+    }
+    err.push_back(std::move(se));
   }
-  return 0;
+  write(name + "_error.svg", report::line_plot(title + ": mean upper-body error per tick", "time (s)", "error (cm)", err));
+  // The traced joint against truth, per coordinate (the thesis's Fig. 5.3/5.4).
+  const eval::StreamScore* kalman = nullptr;
+  for (const auto& s : r.streams) {
+    if (s.name == "kalman") kalman = &s;
+  }
+  for (int axis = 0; axis < 3; ++axis) {
+    std::vector<report::Series> xyz;
+    if (kalman != nullptr) {
+      report::Series truth{"truth", secs(*kalman), {}};
+      for (const auto& p : kalman->trace) truth.y.push_back(p.truth[axis]);
+      xyz.push_back(std::move(truth));
+    }
+    for (const auto& s : r.streams) {
+      if (s.fused && s.name != "kalman" && s.name != "avg") continue;
+      report::Series se{s.name, secs(s), {}};
+      for (const auto& p : s.trace) se.y.push_back(p.joint[axis]);
+      xyz.push_back(std::move(se));
+    }
+    const std::string c(1, "xyz"[axis]);
+    write(name + "_" + joint + "_" + c + ".svg",
+          report::line_plot(title + ": " + joint + " " + c + " (world)", "time (s)", c + " (m)", xyz, 760, 220));
+  }
+  std::vector<report::Strip> strips;
+  for (const auto& s : r.streams) {
+    report::Strip st{s.name, secs(s), {}};
+    for (const auto& p : s.trace) st.on.push_back(std::isfinite(p.error_cm[5]));
+    strips.push_back(std::move(st));
+  }
+  write(name + "_hands_detected.svg", report::timeline(title + ": hands reported at confidence 1", strips));
+  return h.str();
 }
 
 // A recording's raw skeletons, truth (both at their log time, the recorder's
@@ -265,6 +281,86 @@ int fuse_file(const FileOptions& o) {
 
 }  // namespace
 
+int eval_sim(const SimEvalOptions& o) {
+  runtime::ParamSchema schema;
+  sim::add_sim_params(schema);
+  eval::OfflineOptions eo;
+  if (!o.methods.empty()) {
+    eo.methods.clear();
+    for (const auto& m : o.methods) eo.methods.push_back(*fusion::method_from_name(m));
+  }
+  eo.fuser.delay_ns = static_cast<std::int64_t>(o.delay_ms * 1e6);
+  eo.fuser.max_age_ns = static_cast<std::int64_t>(o.max_age_ms * 1e6);
+  eo.trace = !o.report_dir.empty();
+  std::string html;
+  if (eo.trace) std::filesystem::create_directories(o.report_dir);
+  nlohmann::json out = nlohmann::json::array();
+  if (!o.json && !o.quiet) {
+    std::printf("## Fusion against ground truth (simulator)\n\nDetection: %% of output ticks (30 Hz) a joint is reported "
+                "with confidence 1; error: mean distance to truth over those, cm. Singles: each sensor alone, on the same "
+                "ticks. Fusion delay %.0f ms, max sample age %.0f ms.\n",
+                o.delay_ms, o.max_age_ms);
+  }
+  for (const auto& scenario : o.scenarios) {
+    sim::SimConfig cfg;
+    try {
+      std::vector<runtime::RawParam> raw;
+      for (const auto& p : o.params) raw.push_back(runtime::parse_param_assignment(p, "--param " + p));
+      raw.push_back({"scenario", scenario, "--scenarios"});
+      cfg = sim::sim_config_from(schema.resolve(raw, "eval sim"));
+      sim::Simulation probe(cfg);
+    } catch (const runtime::ParamError& e) {
+      throw UsageError(e.what());
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(e.what());
+    }
+    sim::Simulation sim(cfg);
+    std::map<std::string, Eigen::Isometry3d> poses;
+    for (const auto& s : cfg.sensors) poses[s.id] = s.world_from_sensor();
+    std::vector<eval::TimedSkeleton> events;
+    for (auto& e : sim.advance(sim.duration() + 1.0)) {
+      const auto t = cfg.epoch_ns + static_cast<std::int64_t>(std::llround(e.t * 1e9));
+      events.push_back({e.kind == sim::SimEvent::Kind::Truth ? eval::TimedSkeleton::Kind::Truth
+                                                              : eval::TimedSkeleton::Kind::Raw,
+                        t, std::move(e.skeleton)});
+    }
+    const bool progress = !o.json && !o.quiet;
+    if (progress) std::fprintf(stderr, "\revaluating %s (%zu events)...      ", scenario.c_str(), events.size());
+    const auto r = eval::evaluate(poses, events, eo);
+    if (progress) std::fprintf(stderr, "\r%50s\r", "");
+    if (o.quiet) std::fprintf(stderr, "evaluated %s: %zu streams over %llu ticks\n", scenario.c_str(), r.streams.size(),
+                              static_cast<unsigned long long>(r.ticks));
+    nlohmann::json streams = nlohmann::json::array();
+    for (const auto& s : r.streams) streams.push_back(stream_json(s));
+    out.push_back({{"scenario", scenario}, {"sensors", cfg.sensors.size()}, {"profile", cfg.profile},
+                   {"seed", cfg.scenario.seed}, {"ticks", r.ticks}, {"streams", streams}});
+    const std::string title = scenario + " (" + std::to_string(cfg.sensors.size()) + " sensors, " + cfg.profile +
+                              ", seed " + std::to_string(cfg.scenario.seed) + ")";
+    if (!o.json && !o.quiet) print_table(title, r);
+    if (eo.trace) html += report_section(o.report_dir, scenario, title, r, "right_hand");
+  }
+  if (eo.trace) {
+    const auto path = std::filesystem::path(o.report_dir) / "report.html";
+    std::ofstream f(path);
+    f << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>skelgraph fusion report</title><style>"
+         "body{font-family:sans-serif;margin:2em;max-width:1100px}table{border-collapse:collapse;font-size:12px}"
+         "td,th{border:1px solid #ccc;padding:2px 6px;text-align:right}td:first-child{text-align:left}"
+         "figure{margin:1em 0}</style></head><body>\n<h1>skelgraph: fusion against ground truth (simulator)</h1>\n"
+         "<p>Detection: % of 30 Hz output ticks a joint group is reported with confidence 1. Error: mean distance to "
+         "truth over those, cm. Single sensors are scored on the same ticks as the fusion methods. Made by "
+         "<code>skelgraph eval sim --report</code>; every figure is also an SVG file in this directory.</p>\n"
+      << html << "</body></html>\n";
+    if (!f.flush()) throw std::runtime_error("cannot write " + path.string());
+    if (!o.json && !o.quiet) std::printf("\nreport: %s\n", path.string().c_str());
+  }
+  if (o.json && !o.quiet) {
+    std::printf("%s\n", nlohmann::json{{"delay_ms", o.delay_ms}, {"max_age_ms", o.max_age_ms}, {"scenarios", out}}
+                            .dump(2)
+                            .c_str());
+  }
+  return 0;
+}
+
 void add_fuse_command(CLI::App& app, GlobalOptions&, Action& run) {
   auto o = std::make_shared<FileOptions>();
   auto* f = app.add_subcommand("fuse", "Fuse a recording's raw skeletons offline (as the fusion component would live)");
@@ -297,6 +393,7 @@ void add_eval_command(CLI::App& app, GlobalOptions&, Action& run) {
   s->add_option("--delay-ms", o->delay_ms, "fuse this far behind the newest data (room to interpolate)")->check(kNonNegative);
   s->add_option("--max-age-ms", o->max_age_ms, "samples older than this are not fused")->check(kPositive);
   s->add_flag("--json", o->json, "machine-readable results");
+  s->add_option("--report", o->report_dir, "also write DIR/report.html (tables, inline SVG plots) and each plot as SVG");
   s->callback([o, &run] { run = [o] { return eval_sim(*o); }; });
 
   auto fo = std::make_shared<FileOptions>();

@@ -1,6 +1,7 @@
 #include "skelgraph/eval/offline.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 namespace skelgraph::eval {
 
@@ -75,6 +76,9 @@ OfflineResult evaluate(const std::map<std::string, Eigen::Isometry3d>& world_fro
       // Each true person is scored against the fused person nearest it; a
       // person nobody reports is a missed frame.
       bool scored = false;
+      TracePoint tp;
+      tp.t_ns = at;
+      tp.error_cm.fill(std::nan(""));
       for (const auto& f : fused) {
         const auto c = skeleton::centre_of(f);
         if (!c) continue;
@@ -82,9 +86,23 @@ OfflineResult evaluate(const std::map<std::string, Eigen::Isometry3d>& world_fro
         if (!t || ((*t)[skeleton::JointId::Torso].position - *c).norm() > 1.0) continue;  // a ghost, not the person
         lane.score.accuracy.add(f, *t);
         scored = true;
+        if (options.trace) {
+          std::array<double, kGroupCount> sum{}, n{};
+          for (std::size_t j = 0; j < skeleton::kJointCount; ++j) {
+            const int g = group_of(skeleton::joint_at(j));
+            if (g < 0 || f.joints[j].confidence < skeleton::kTracked) continue;
+            sum[g] += 100.0 * (f.joints[j].position - t->joints[j].position).norm();
+            n[g] += 1;
+          }
+          for (std::size_t g = 0; g < kGroupCount; ++g) tp.error_cm[g] = n[g] > 0 ? sum[g] / n[g] : std::nan("");
+          const auto& tj = f[options.trace_joint];
+          if (tj.confidence >= skeleton::kTracked) tp.joint = tj.position;
+          tp.truth = (*t)[options.trace_joint].position;
+        }
         break;
       }
       if (!scored) lane.score.accuracy.add_missed();
+      if (options.trace) lane.score.trace.push_back(tp);
     }
   }
   for (auto& lane : lanes) {

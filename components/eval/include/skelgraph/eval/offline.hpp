@@ -6,6 +6,8 @@
 // eval` feeds it from the simulator or from a recording.
 
 #include <cstdint>
+#include <array>
+#include <cmath>
 #include <functional>
 #include <map>
 #include <string>
@@ -32,6 +34,16 @@ struct OfflineOptions {
   fusion::FuserOptions fuser;        // method is set per stream
   std::int64_t period_ns = 33'333'333;  // output ticks (30 Hz)
   bool singles = true;                // also every sensor on its own
+  bool trace = false;                 // keep per-tick series for plots (StreamScore::trace)
+  skeleton::JointId trace_joint = skeleton::JointId::RightHand;
+};
+
+// One output tick of one stream, for plots.
+struct TracePoint {
+  std::int64_t t_ns = 0;
+  std::array<double, kGroupCount> error_cm{};  // per group, mean over its joints at confidence 1; NaN if none
+  Eigen::Vector3d joint = Eigen::Vector3d::Constant(std::nan(""));  // the traced joint (NaN if not at confidence 1)
+  Eigen::Vector3d truth = Eigen::Vector3d::Constant(std::nan(""));  // the truth of that joint at the tick
 };
 
 struct StreamScore {
@@ -40,6 +52,7 @@ struct StreamScore {
   Accumulator accuracy;  // against truth (empty without truth)
   Steadiness steadiness;
   std::uint64_t ticks = 0, with_output = 0;
+  std::vector<TracePoint> trace;  // with OfflineOptions::trace
 };
 
 struct OfflineResult {

@@ -1,0 +1,29 @@
+#pragma once
+// Self-contained figures and an HTML report (inline SVG, no scripts, no
+// network): what `skelgraph eval ... --report DIR` writes.
+
+#include <string>
+#include <vector>
+
+namespace skelgraph::cli::report {
+
+struct Series {
+  std::string name;
+  std::vector<double> x, y;  // NaN in y breaks the line
+};
+
+// A line plot as a standalone SVG document.
+std::string line_plot(const std::string& title, const std::string& x_label, const std::string& y_label,
+                      const std::vector<Series>& series, int width = 760, int height = 260);
+
+// Rows of a stream-by-stream timeline: a bar where `on` is true.
+struct Strip {
+  std::string name;
+  std::vector<double> x;
+  std::vector<bool> on;
+};
+std::string timeline(const std::string& title, const std::vector<Strip>& strips, int width = 760);
+
+std::string html_escape(const std::string& s);
+
+}  // namespace skelgraph::cli::report
