@@ -148,7 +148,9 @@ struct RecordingInputs {
   std::uint64_t raw = 0, truth = 0;
 };
 
-RecordingInputs read_recording(const std::string& file) {
+// shared_frame: every sensor's skeletons are already in one frame (data sets
+// such as KinectMultiTrack map them so): identity poses, no calibration needed.
+RecordingInputs read_recording(const std::string& file, bool shared_frame) {
   RecordingInputs in;
   try {
     const mcap::Reader reader(file);
@@ -175,9 +177,10 @@ RecordingInputs read_recording(const std::string& file) {
                    [](const eval::TimedSkeleton& a, const eval::TimedSkeleton& b) { return a.t_ns < b.t_ns; });
   if (in.raw == 0) throw UsageError(file + ": no raw skeletons on " + runtime::topics::kSkeletonRaw.name);
   for (const auto& e : in.events) {
+    if (shared_frame && e.kind == eval::TimedSkeleton::Kind::Raw) in.poses[e.skeleton.sensor_id] = Eigen::Isometry3d::Identity();
     if (e.kind == eval::TimedSkeleton::Kind::Raw && !in.poses.count(e.skeleton.sensor_id)) {
       throw UsageError(file + ": no pose of sensor '" + e.skeleton.sensor_id + "' on " +
-                       runtime::topics::kCalibration.name + " (calibrate it, or record the calibration topic)");
+                       runtime::topics::kCalibration.name + " (calibrate it, record the calibration topic, or --shared-frame if the data is already in one frame)");
     }
   }
   return in;
@@ -187,7 +190,7 @@ struct FileOptions {
   std::string file, out;
   std::vector<std::string> methods;
   double delay_ms = 0, max_age_ms = 100;
-  bool json = false;
+  bool json = false, shared_frame = false;
 };
 
 eval::OfflineOptions offline_options(const FileOptions& o) {
@@ -204,7 +207,7 @@ eval::OfflineOptions offline_options(const FileOptions& o) {
 // skelgraph eval FILE: single sensors and every method, against the truth in the
 // recording if it has one; bone-length steadiness and completeness either way.
 int eval_file(const FileOptions& o) {
-  const auto in = read_recording(o.file);
+  const auto in = read_recording(o.file, o.shared_frame);
   const auto r = eval::evaluate(in.poses, in.events, offline_options(o));
   nlohmann::json streams = nlohmann::json::array();
   for (const auto& s : r.streams) streams.push_back(stream_json(s));
@@ -227,7 +230,7 @@ int eval_file(const FileOptions& o) {
 // skelgraph fuse IN --out OUT: the recording with fused skeletons added on
 // skelgraph/skeleton/fused (sensor_id "fused", or "fused_<method>" for several).
 int fuse_file(const FileOptions& o) {
-  const auto in = read_recording(o.file);
+  const auto in = read_recording(o.file, o.shared_frame);
   const auto eo = offline_options(o);
   std::vector<std::pair<std::int64_t, skeleton::Skeleton>> fused;
   const auto r = eval::evaluate(in.poses, in.events, [&] { auto x = eo; x.singles = false; return x; }(),
@@ -374,6 +377,7 @@ void add_fuse_command(CLI::App& app, GlobalOptions&, Action& run) {
   f->add_option("--delay-ms", o->delay_ms, "fuse this far behind the newest data")->check(kNonNegative);
   f->add_option("--max-age-ms", o->max_age_ms, "samples older than this are not fused")->check(kPositive);
   f->add_flag("--json", o->json, "machine-readable summary");
+  f->add_flag("--shared-frame", o->shared_frame, "the sensors' skeletons are already in one frame (e.g. KinectMultiTrack): no poses needed");
   f->callback([o, &run] {
     if (o->methods.empty()) o->methods = {"kalman"};
     run = [o] { return fuse_file(*o); };
@@ -407,6 +411,7 @@ void add_eval_command(CLI::App& app, GlobalOptions&, Action& run) {
   r->add_option("--delay-ms", fo->delay_ms, "fuse this far behind the newest data")->check(kNonNegative);
   r->add_option("--max-age-ms", fo->max_age_ms, "samples older than this are not fused")->check(kPositive);
   r->add_flag("--json", fo->json, "machine-readable results");
+  r->add_flag("--shared-frame", fo->shared_frame, "the sensors' skeletons are already in one frame (e.g. KinectMultiTrack): no poses needed");
   r->callback([fo, &run] { run = [fo] { return eval_file(*fo); }; });
 }
 
