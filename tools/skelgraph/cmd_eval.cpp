@@ -193,16 +193,17 @@ struct FileOptions {
   bool json = false, shared_frame = false;
 };
 
-eval::OfflineOptions offline_options(const FileOptions& o) {
+eval::OfflineOptions offline_options(const std::vector<std::string>& methods, double delay_ms, double max_age_ms) {
   eval::OfflineOptions eo;
-  if (!o.methods.empty()) {
+  if (!methods.empty()) {
     eo.methods.clear();
-    for (const auto& m : o.methods) eo.methods.push_back(*fusion::method_from_name(m));
+    for (const auto& m : methods) eo.methods.push_back(*fusion::method_from_name(m));
   }
-  eo.fuser.delay_ns = static_cast<std::int64_t>(o.delay_ms * 1e6);
-  eo.fuser.max_age_ns = static_cast<std::int64_t>(o.max_age_ms * 1e6);
+  eo.fuser.delay_ns = static_cast<std::int64_t>(delay_ms * 1e6);
+  eo.fuser.max_age_ns = static_cast<std::int64_t>(max_age_ms * 1e6);
   return eo;
 }
+eval::OfflineOptions offline_options(const FileOptions& o) { return offline_options(o.methods, o.delay_ms, o.max_age_ms); }
 
 // skelgraph eval FILE: single sensors and every method, against the truth in the
 // recording if it has one; bone-length steadiness and completeness either way.
@@ -287,13 +288,7 @@ int fuse_file(const FileOptions& o) {
 int eval_sim(const SimEvalOptions& o) {
   runtime::ParamSchema schema;
   sim::add_sim_params(schema);
-  eval::OfflineOptions eo;
-  if (!o.methods.empty()) {
-    eo.methods.clear();
-    for (const auto& m : o.methods) eo.methods.push_back(*fusion::method_from_name(m));
-  }
-  eo.fuser.delay_ns = static_cast<std::int64_t>(o.delay_ms * 1e6);
-  eo.fuser.max_age_ns = static_cast<std::int64_t>(o.max_age_ms * 1e6);
+  eval::OfflineOptions eo = offline_options(o.methods, o.delay_ms, o.max_age_ms);
   eo.trace = !o.report_dir.empty();
   std::string html;
   if (eo.trace) std::filesystem::create_directories(o.report_dir);
@@ -364,6 +359,16 @@ int eval_sim(const SimEvalOptions& o) {
   return 0;
 }
 
+namespace {
+// The fusion options every command here shares.
+void add_fusion_options(CLI::App* cmd, std::vector<std::string>& methods, double& delay_ms, double& max_age_ms,
+                        const std::string& methods_help) {
+  cmd->add_option("--methods,--method", methods, methods_help)->delimiter(',')->check(CLI::IsMember(fusion::method_names()));
+  cmd->add_option("--delay-ms", delay_ms, "fuse this far behind the newest data (room to interpolate)")->check(kNonNegative);
+  cmd->add_option("--max-age-ms", max_age_ms, "samples older than this are not fused")->check(kPositive);
+}
+}  // namespace
+
 void add_fuse_command(CLI::App& app, GlobalOptions&, Action& run) {
   auto o = std::make_shared<FileOptions>();
   auto* f = app.add_subcommand("fuse", "Fuse a recording's raw skeletons offline (as the fusion component would live)");
@@ -371,11 +376,8 @@ void add_fuse_command(CLI::App& app, GlobalOptions&, Action& run) {
       ->required()
       ->check(CLI::ExistingFile);
   f->add_option("--out", o->out, "MCAP file to write: the input plus skelgraph/skeleton/fused")->required();
-  f->add_option("--method", o->methods, "fusion method(s); several: sensor_id fused_<method> each (default kalman)")
-      ->delimiter(',')
-      ->check(CLI::IsMember(fusion::method_names()));
-  f->add_option("--delay-ms", o->delay_ms, "fuse this far behind the newest data")->check(kNonNegative);
-  f->add_option("--max-age-ms", o->max_age_ms, "samples older than this are not fused")->check(kPositive);
+  add_fusion_options(f, o->methods, o->delay_ms, o->max_age_ms,
+                     "fusion method(s); several: sensor_id fused_<method> each (default kalman)");
   f->add_flag("--json", o->json, "machine-readable summary");
   f->add_flag("--shared-frame", o->shared_frame, "the sensors' skeletons are already in one frame (e.g. KinectMultiTrack): no poses needed");
   f->callback([o, &run] {
@@ -391,11 +393,7 @@ void add_eval_command(CLI::App& app, GlobalOptions&, Action& run) {
   auto* s = ev->add_subcommand("sim", "Simulated scenarios through every fusion method (no DDS, as fast as the CPU allows)");
   s->add_option("-p,--param", o->params, "simulator parameter NAME=VALUE (as the sim component's; e.g. sensor_count=2)");
   s->add_option("--scenarios", o->scenarios, "scenarios to run (default: the thesis's seven)")->delimiter(',');
-  s->add_option("--methods", o->methods, "fusion methods (default: all)")
-      ->delimiter(',')
-      ->check(CLI::IsMember(fusion::method_names()));
-  s->add_option("--delay-ms", o->delay_ms, "fuse this far behind the newest data (room to interpolate)")->check(kNonNegative);
-  s->add_option("--max-age-ms", o->max_age_ms, "samples older than this are not fused")->check(kPositive);
+  add_fusion_options(s, o->methods, o->delay_ms, o->max_age_ms, "fusion methods (default: all)");
   s->add_flag("--json", o->json, "machine-readable results");
   s->add_option("--report", o->report_dir, "also write DIR/report.html (tables, inline SVG plots) and each plot as SVG");
   s->callback([o, &run] { run = [o] { return eval_sim(*o); }; });
@@ -405,11 +403,7 @@ void add_eval_command(CLI::App& app, GlobalOptions&, Action& run) {
   r->add_option("file", fo->file, "MCAP recording with skelgraph/skeleton/raw, skelgraph/calibration (and truth)")
       ->required()
       ->check(CLI::ExistingFile);
-  r->add_option("--methods", fo->methods, "fusion methods (default: all)")
-      ->delimiter(',')
-      ->check(CLI::IsMember(fusion::method_names()));
-  r->add_option("--delay-ms", fo->delay_ms, "fuse this far behind the newest data")->check(kNonNegative);
-  r->add_option("--max-age-ms", fo->max_age_ms, "samples older than this are not fused")->check(kPositive);
+  add_fusion_options(r, fo->methods, fo->delay_ms, fo->max_age_ms, "fusion methods (default: all)");
   r->add_flag("--json", fo->json, "machine-readable results");
   r->add_flag("--shared-frame", fo->shared_frame, "the sensors' skeletons are already in one frame (e.g. KinectMultiTrack): no poses needed");
   r->callback([fo, &run] { run = [fo] { return eval_file(*fo); }; });
