@@ -61,6 +61,10 @@ int main(int argc, char** argv) {
     }
   }
   const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  // Large best-effort samples live in this process's shared-memory segment
+  // until the reader has taken them: stay a moment so the last frames are not
+  // destroyed in flight (a real source keeps running).
+  std::this_thread::sleep_for(std::chrono::seconds(1));
   std::printf("%s\n", nlohmann::json{{"skeleton_raw", n_skel}, {"depth", n_depth}, {"failed", failed},
                                      {"seconds", elapsed}, {"depth_frame_bytes", mm.size() * 2}}
                           .dump()
