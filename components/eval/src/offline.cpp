@@ -2,8 +2,55 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace skelgraph::eval {
+
+namespace {
+// A skeleton's body frame: x to its left (shoulders), y up, z forward;
+// empty without both shoulders.
+std::optional<Eigen::Matrix3d> body_frame(const skeleton::Skeleton& s) {
+  const auto& l = s[skeleton::JointId::LeftShoulder];
+  const auto& r = s[skeleton::JointId::RightShoulder];
+  if (l.confidence <= 0 || r.confidence <= 0) return std::nullopt;
+  Eigen::Vector3d x = l.position - r.position;
+  x.y() = 0;
+  if (x.norm() < 1e-6) return std::nullopt;
+  x.normalize();
+  const Eigen::Vector3d y = Eigen::Vector3d::UnitY();
+  Eigen::Matrix3d m;
+  m.col(0) = x;
+  m.col(1) = y;
+  m.col(2) = x.cross(y);
+  return m;
+}
+
+struct OffsetModel {
+  std::array<Eigen::Vector3d, skeleton::kJointCount> sum{};
+  std::array<double, skeleton::kJointCount> n{};
+  OffsetModel() {
+    for (auto& v : sum) v.setZero();
+  }
+  // The body frame is the truth's (the person's), in which a tracker's convention offsets are constant.
+  void learn(const skeleton::Skeleton& est, const skeleton::Skeleton& truth) {
+    const auto R = body_frame(truth);
+    if (!R) return;
+    for (std::size_t j = 0; j < skeleton::kJointCount; ++j) {
+      if (est.joints[j].confidence < skeleton::kTracked) continue;
+      sum[j] += R->transpose() * (est.joints[j].position - truth.joints[j].position);
+      n[j] += 1;
+    }
+  }
+  skeleton::Skeleton apply(skeleton::Skeleton est, const skeleton::Skeleton& truth) const {
+    const auto R = body_frame(truth);
+    if (!R) return est;
+    for (std::size_t j = 0; j < skeleton::kJointCount; ++j) {
+      if (n[j] > 0) est.joints[j].position -= *R * (sum[j] / n[j]);
+    }
+    return est;
+  }
+};
+}  // namespace
 
 OfflineResult evaluate(const std::map<std::string, Eigen::Isometry3d>& world_from_sensor,
                        const std::vector<TimedSkeleton>& events, const OfflineOptions& options,
@@ -13,6 +60,7 @@ OfflineResult evaluate(const std::map<std::string, Eigen::Isometry3d>& world_fro
     fusion::Fuser fuser;
     std::string only_sensor;  // singles: the one sensor fed
     fusion::Method method;
+    OffsetModel offsets;
   };
   std::vector<Lane> lanes;
   std::vector<std::string> sensor_ids;
@@ -25,7 +73,7 @@ OfflineResult evaluate(const std::map<std::string, Eigen::Isometry3d>& world_fro
   auto make_lane = [&](const std::string& name, bool fused, fusion::Method m, const std::string& only) {
     auto fo = options.fuser;
     fo.method = m;
-    Lane lane{{}, fusion::Fuser(fo), only, m};
+    Lane lane{{}, fusion::Fuser(fo), only, m, {}};
     lane.score.name = name;
     lane.score.fused = fused;
     for (const auto& [id, pose] : world_from_sensor) lane.fuser.set_pose(id, pose);
@@ -38,11 +86,14 @@ OfflineResult evaluate(const std::map<std::string, Eigen::Isometry3d>& world_fro
 
   OfflineResult result;
   TruthTimeline truth;
-  std::int64_t first = 0, last = 0;
+  std::int64_t first = 0, last = 0, first_truth = 0;
+  bool any_truth = false;
   bool any_raw = false;
   for (const auto& e : events) {
     if (e.kind == TimedSkeleton::Kind::Truth) {
       truth.add(e.skeleton, e.t_ns);
+      if (!any_truth || e.t_ns < first_truth) first_truth = e.t_ns;
+      any_truth = true;
       result.has_truth = true;
     } else {
       if (!any_raw) first = e.t_ns;
@@ -86,6 +137,12 @@ OfflineResult evaluate(const std::map<std::string, Eigen::Isometry3d>& world_fro
         if (!t || ((*t)[skeleton::JointId::Torso].position - *c).norm() > 1.0) continue;  // a ghost, not the person
         lane.score.accuracy.add(f, *t);
         scored = true;
+        if (at - first_truth < static_cast<std::int64_t>(options.compensation_s * 1e9)) {
+          lane.offsets.learn(f, *t);
+        } else {
+          lane.score.compensated.add(lane.offsets.apply(f, *t), *t);
+          lane.score.after_calibration.add(f, *t);
+        }
         if (options.trace) {
           std::array<double, kGroupCount> sum{}, n{};
           for (std::size_t j = 0; j < skeleton::kJointCount; ++j) {
@@ -101,7 +158,13 @@ OfflineResult evaluate(const std::map<std::string, Eigen::Isometry3d>& world_fro
         }
         break;
       }
-      if (!scored) lane.score.accuracy.add_missed();
+      if (!scored) {
+        lane.score.accuracy.add_missed();
+        if (at - first_truth >= static_cast<std::int64_t>(options.compensation_s * 1e9)) {
+          lane.score.compensated.add_missed();
+          lane.score.after_calibration.add_missed();
+        }
+      }
       if (options.trace) lane.score.trace.push_back(tp);
     }
   }

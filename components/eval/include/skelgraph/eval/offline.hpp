@@ -35,6 +35,10 @@ struct OfflineOptions {
   std::int64_t period_ns = 33'333'333;  // output ticks (30 Hz)
   bool singles = true;                // also every sensor on its own
   bool trace = false;                 // keep per-tick series for plots (StreamScore::trace)
+  // Constant per-joint offsets between the stream's skeleton convention and
+  // the truth's, estimated in the stream's own body frame over the first
+  // `compensation_s` of truth and removed afterwards (StreamScore::compensated).
+  double compensation_s = 5.0;
   skeleton::JointId trace_joint = skeleton::JointId::RightHand;
 };
 
@@ -50,6 +54,8 @@ struct StreamScore {
   std::string name;      // a sensor id, or a method name
   bool fused = false;
   Accumulator accuracy;  // against truth (empty without truth)
+  Accumulator after_calibration;  // the same ticks as `compensated`, offsets kept (the fair comparison)
+  Accumulator compensated;        // after the calibration segment, with per-joint offsets removed
   Steadiness steadiness;
   std::uint64_t ticks = 0, with_output = 0;
   std::vector<TracePoint> trace;  // with OfflineOptions::trace
