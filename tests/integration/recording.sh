@@ -60,6 +60,10 @@ assert any(k.startswith("skelgraph/skeleton/truth") and v >= 0.9 * ticks for k, 
 print("ticks %d acked by both hosts; offsets %s; frames at ticks %s" % (ticks, {h: "%.3f ms" % (o / 1e6) for h, o in off.items()}, at))
 PY
 ok "two hosts: every tick acked by both, offset of hostB found, merged onto one timeline"
+# Fused offline on the merged session's own sync ticks, as the live component would.
+"$SKELGRAPH" eval recording "$WORK/merged.mcap" --methods avg,kalman --json >"$WORK/eval.json" || fail "eval of the merged recording"
+json_check "$WORK/eval.json" 'd["on_sync_ticks"] and d["ticks"] == '"$ticks"' and d["has_truth"]'
+ok "merged recording fused on its $ticks sync ticks: kalman $(json_get "$WORK/eval.json" 'round([s for s in d["streams"] if s["stream"] == "kalman"][0]["mean_error_cm"], 1)') cm"
 
 # A recording replayed and recorded again: the same count on every topic.
 a_file=$(ls "$WORK/rec"/two_hosts_*_hostA.mcap)

@@ -148,6 +148,7 @@ std::string report_section(const std::string& dir, const std::string& name, cons
 struct RecordingInputs {
   std::map<std::string, Eigen::Isometry3d> poses;
   std::vector<eval::TimedSkeleton> events;
+  std::vector<std::int64_t> ticks;  // log times of the sync TICKs, if the session was synchronised
   std::uint64_t raw = 0, truth = 0;
 };
 
@@ -163,6 +164,10 @@ RecordingInputs read_recording(const std::string& file, bool shared_frame) {
       if (schema->name == msg::MessageTraits<msg::SensorPose>::name && ch.topic == runtime::topics::kCalibration.name) {
         const auto p = skeleton::from_msg(msg::from_cdr<msg::SensorPose>(bytes, m.data.size()));
         if (p.frame_id == "world") in.poses[p.sensor_id] = p.pose;
+      } else if (ch.topic == runtime::topics::kSync.name && schema->name == msg::MessageTraits<msg::SyncCommand>::name) {
+        if (msg::from_cdr<msg::SyncCommand>(bytes, m.data.size()).kind() == msg::SYNC_TICK) {
+          in.ticks.push_back(static_cast<std::int64_t>(m.log_time));
+        }
       } else if (schema->name == msg::MessageTraits<msg::Skeleton>::name) {
         const bool raw = ch.topic == runtime::topics::kSkeletonRaw.name;
         const bool truth = ch.topic == runtime::topics::kSkeletonTruth.name;
@@ -176,6 +181,7 @@ RecordingInputs read_recording(const std::string& file, bool shared_frame) {
   } catch (const mcap::McapError& e) {
     throw UsageError(e.what());
   }
+  std::sort(in.ticks.begin(), in.ticks.end());
   std::stable_sort(in.events.begin(), in.events.end(),
                    [](const eval::TimedSkeleton& a, const eval::TimedSkeleton& b) { return a.t_ns < b.t_ns; });
   if (in.raw == 0) throw UsageError(file + ": no raw skeletons on " + runtime::topics::kSkeletonRaw.name);
@@ -206,24 +212,31 @@ eval::OfflineOptions offline_options(const std::vector<std::string>& methods, do
   eo.fuser.max_age_ns = static_cast<std::int64_t>(max_age_ms * 1e6);
   return eo;
 }
-eval::OfflineOptions offline_options(const FileOptions& o) { return offline_options(o.methods, o.delay_ms, o.max_age_ms); }
+// A recording's fusion runs on its sync TICKs when it has them (as the live component does), else at 30 Hz.
+eval::OfflineOptions offline_options(const FileOptions& o, const RecordingInputs& in) {
+  auto eo = offline_options(o.methods, o.delay_ms, o.max_age_ms);
+  eo.tick_times = in.ticks;
+  return eo;
+}
 
 // skelgraph eval FILE: single sensors and every method, against the truth in the
 // recording if it has one; bone-length steadiness and completeness either way.
 int eval_file(const FileOptions& o) {
   const auto in = read_recording(o.file, o.shared_frame);
-  const auto r = eval::evaluate(in.poses, in.events, offline_options(o));
+  const auto r = eval::evaluate(in.poses, in.events, offline_options(o, in));
   nlohmann::json streams = nlohmann::json::array();
   for (const auto& s : r.streams) streams.push_back(stream_json(s));
   if (o.json) {
     std::printf("%s\n", nlohmann::json{{"file", o.file}, {"has_truth", r.has_truth}, {"ticks", r.ticks},
+                                       {"on_sync_ticks", !in.ticks.empty()},
                                        {"raw_skeletons", in.raw}, {"truth_skeletons", in.truth}, {"streams", streams}}
                             .dump(2)
                             .c_str());
   } else {
-    std::printf("## %s\n\n%llu raw skeletons from %zu sensor(s), %llu truth skeletons, %llu output ticks (30 Hz)\n",
+    std::printf("## %s\n\n%llu raw skeletons from %zu sensor(s), %llu truth skeletons, %llu output ticks (%s)\n",
                 o.file.c_str(), static_cast<unsigned long long>(in.raw), in.poses.size(),
-                static_cast<unsigned long long>(in.truth), static_cast<unsigned long long>(r.ticks));
+                static_cast<unsigned long long>(in.truth), static_cast<unsigned long long>(r.ticks),
+                in.ticks.empty() ? "30 Hz" : "the recording's sync ticks");
     if (!r.has_truth) std::printf("No ground truth in the recording: detection and error columns are empty; "
                                   "upper-body completeness and bone-length SD need none.\n");
     print_table(o.file, r);
@@ -235,7 +248,7 @@ int eval_file(const FileOptions& o) {
 // skelgraph/skeleton/fused (sensor_id "fused", or "fused_<method>" for several).
 int fuse_file(const FileOptions& o) {
   const auto in = read_recording(o.file, o.shared_frame);
-  const auto eo = offline_options(o);
+  const auto eo = offline_options(o, in);
   std::vector<std::pair<std::int64_t, skeleton::Skeleton>> fused;
   const auto r = eval::evaluate(in.poses, in.events, [&] { auto x = eo; x.singles = false; return x; }(),
                                 [&](fusion::Method m, const skeleton::Skeleton& s) {
@@ -276,6 +289,7 @@ int fuse_file(const FileOptions& o) {
   }
   if (o.json) {
     std::printf("%s\n", nlohmann::json{{"in", o.file}, {"out", o.out}, {"copied", copied}, {"fused", fused.size()},
+                                       {"on_sync_ticks", !in.ticks.empty()},
                                        {"ticks", r.ticks}, {"methods", per}}
                             .dump(2)
                             .c_str());

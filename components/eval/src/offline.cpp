@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 
 namespace skelgraph::eval {
@@ -102,8 +103,12 @@ OfflineResult evaluate(const std::map<std::string, Eigen::Isometry3d>& world_fro
     }
   }
   if (!any_raw) return result;
+  std::vector<std::int64_t> ticks = options.tick_times;
+  if (ticks.empty()) {
+    for (std::int64_t tick = first; tick <= last + options.period_ns; tick += options.period_ns) ticks.push_back(tick);
+  }
   std::size_t next = 0;
-  for (std::int64_t tick = first; tick <= last + options.period_ns; tick += options.period_ns) {
+  for (const std::int64_t tick : ticks) {
     // Everything that arrived up to this tick goes in first.
     for (; next < events.size() && events[next].t_ns <= tick; ++next) {
       const auto& e = events[next];
@@ -130,7 +135,17 @@ OfflineResult evaluate(const std::map<std::string, Eigen::Isometry3d>& world_fro
       TracePoint tp;
       tp.t_ns = at;
       tp.error_cm.fill(std::nan(""));
-      for (const auto& f : fused) {
+      // The fused person nearest the true one is the person; others are ghosts.
+      std::vector<const skeleton::Skeleton*> order;
+      for (const auto& f : fused) order.push_back(&f);
+      const auto dist = [&](const skeleton::Skeleton* f) {
+        const auto c = skeleton::centre_of(*f);
+        const auto t = c ? truth.at(at, *c) : std::nullopt;
+        return t ? ((*t)[skeleton::JointId::Torso].position - *c).norm() : std::numeric_limits<double>::infinity();
+      };
+      std::stable_sort(order.begin(), order.end(), [&](auto* a, auto* b) { return dist(a) < dist(b); });
+      for (const auto* fp : order) {
+        const auto& f = *fp;
         const auto c = skeleton::centre_of(f);
         if (!c) continue;
         const auto t = truth.at(at, *c);

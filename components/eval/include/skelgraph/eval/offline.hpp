@@ -32,7 +32,8 @@ struct OfflineOptions {
   std::vector<fusion::Method> methods = {fusion::Method::Avg, fusion::Method::Sum, fusion::Method::Facing,
                                          fusion::Method::Weighted, fusion::Method::Kalman};
   fusion::FuserOptions fuser;        // method is set per stream
-  std::int64_t period_ns = 33'333'333;  // output ticks (30 Hz)
+  std::int64_t period_ns = 33'333'333;  // output ticks (30 Hz)...
+  std::vector<std::int64_t> tick_times;  // ...unless given (sync TICKs in a recording), in order
   bool singles = true;                // also every sensor on its own
   bool trace = false;                 // keep per-tick series for plots (StreamScore::trace)
   // Constant per-joint offsets between the stream's skeleton convention and
@@ -72,7 +73,7 @@ struct OfflineResult {
 using FusedSink = std::function<void(fusion::Method, const skeleton::Skeleton&)>;
 
 // `events` in time order. Ticks run from the first raw event to the last at
-// `period_ns`; a tick counts for accuracy when truth covers it.
+// `period_ns` (or are `tick_times`); a tick counts for accuracy when truth covers it.
 OfflineResult evaluate(const std::map<std::string, Eigen::Isometry3d>& world_from_sensor,
                        const std::vector<TimedSkeleton>& events, const OfflineOptions& options,
                        const FusedSink& sink = {});
