@@ -248,9 +248,10 @@ int eval_file(const FileOptions& o) {
 // skelgraph/skeleton/fused (sensor_id "fused", or "fused_<method>" for several).
 int fuse_file(const FileOptions& o) {
   const auto in = read_recording(o.file, o.shared_frame);
-  const auto eo = offline_options(o, in);
+  auto eo = offline_options(o, in);
+  eo.singles = false;  // only the methods go into the file
   std::vector<std::pair<std::int64_t, skeleton::Skeleton>> fused;
-  const auto r = eval::evaluate(in.poses, in.events, [&] { auto x = eo; x.singles = false; return x; }(),
+  const auto r = eval::evaluate(in.poses, in.events, eo,
                                 [&](fusion::Method m, const skeleton::Skeleton& s) {
                                   auto f = s;
                                   f.sensor_id = eo.methods.size() == 1 ? "fused" : std::string("fused_") + fusion::method_name(m);

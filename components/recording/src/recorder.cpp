@@ -83,7 +83,8 @@ void Recorder::fail(const std::string& what) {
   last_error_ = what;
   const std::string path = session_ ? session_->path() : std::string();
   session_.reset();
-  ctx_.set_health(runtime::HealthState::Error, "recording stopped: " + what + (path.empty() ? "" : "; salvage with: skelgraph bag recover " + path));
+  const std::string salvage = path.empty() ? "" : "; salvage with: skelgraph bag recover " + path;
+  ctx_.set_health(runtime::HealthState::Error, "recording stopped: " + what + salvage);
   spdlog::error("{}: recording stopped: {}", ctx_.name(), what);
 }
 
