@@ -26,27 +26,56 @@ std::optional<Eigen::Matrix3d> body_frame(const skeleton::Skeleton& s) {
   return m;
 }
 
+// Constant per-joint offsets of a stream against the truth, in the truth's
+// body frame (where a tracker's convention offsets are constant). Learnt
+// robustly on the calibration segment: only while the person stands still
+// (a moving person adds the tracker's lag), not in the first second after the
+// stream picks the person up (a fresh skeleton is still settling), and as the
+// per-axis median (a flipped or occluded frame does not drag it).
 struct OffsetModel {
-  std::array<Eigen::Vector3d, skeleton::kJointCount> sum{};
-  std::array<double, skeleton::kJointCount> n{};
-  OffsetModel() {
-    for (auto& v : sum) v.setZero();
-  }
-  // The body frame is the truth's (the person's), in which a tracker's convention offsets are constant.
-  void learn(const skeleton::Skeleton& est, const skeleton::Skeleton& truth) {
+  static constexpr std::int64_t kSettleNs = 1'000'000'000;
+  static constexpr double kStillMps = 0.25;
+  std::array<std::vector<Eigen::Vector3d>, skeleton::kJointCount> samples;
+  std::array<Eigen::Vector3d, skeleton::kJointCount> offset{};
+  std::array<bool, skeleton::kJointCount> known{};
+  std::int64_t reporting_since = -1, last_seen = -1;
+  bool solved = false;
+
+  // Called on every scored tick of the segment; `speed` is the truth torso's.
+  void learn(const skeleton::Skeleton& est, const skeleton::Skeleton& truth, std::int64_t t, double speed) {
+    if (last_seen < 0 || t - last_seen > 200'000'000) reporting_since = t;
+    last_seen = t;
+    if (t - reporting_since < kSettleNs || speed > kStillMps) return;
     const auto R = body_frame(truth);
     if (!R) return;
     for (std::size_t j = 0; j < skeleton::kJointCount; ++j) {
       if (est.joints[j].confidence < skeleton::kTracked) continue;
-      sum[j] += R->transpose() * (est.joints[j].position - truth.joints[j].position);
-      n[j] += 1;
+      samples[j].push_back(R->transpose() * (est.joints[j].position - truth.joints[j].position));
     }
   }
-  skeleton::Skeleton apply(skeleton::Skeleton est, const skeleton::Skeleton& truth) const {
+  void solve() {
+    if (solved) return;
+    solved = true;
+    for (std::size_t j = 0; j < skeleton::kJointCount; ++j) {
+      auto& v = samples[j];
+      if (v.size() < 10) continue;  // too little to say: left as it is
+      for (int a = 0; a < 3; ++a) {
+        std::vector<double> c;
+        for (const auto& x : v) c.push_back(x[a]);
+        std::nth_element(c.begin(), c.begin() + c.size() / 2, c.end());
+        offset[j][a] = c[c.size() / 2];
+      }
+      known[j] = true;
+      v.clear();
+      v.shrink_to_fit();
+    }
+  }
+  skeleton::Skeleton apply(skeleton::Skeleton est, const skeleton::Skeleton& truth) {
+    solve();
     const auto R = body_frame(truth);
     if (!R) return est;
     for (std::size_t j = 0; j < skeleton::kJointCount; ++j) {
-      if (n[j] > 0) est.joints[j].position -= *R * (sum[j] / n[j]);
+      if (known[j]) est.joints[j].position -= *R * offset[j];
     }
     return est;
   }
@@ -153,7 +182,11 @@ OfflineResult evaluate(const std::map<std::string, Eigen::Isometry3d>& world_fro
         lane.score.accuracy.add(f, *t);
         scored = true;
         if (at - first_truth < static_cast<std::int64_t>(options.compensation_s * 1e9)) {
-          lane.offsets.learn(f, *t);
+          const auto before = truth.at(at - 100'000'000, (*t)[skeleton::JointId::Torso].position);
+          const double speed =
+              before ? ((*t)[skeleton::JointId::Torso].position - (*before)[skeleton::JointId::Torso].position).norm() / 0.1
+                     : std::numeric_limits<double>::infinity();
+          lane.offsets.learn(f, *t, at, speed);
         } else {
           lane.score.compensated.add(lane.offsets.apply(f, *t), *t);
           lane.score.after_calibration.add(f, *t);

@@ -137,6 +137,7 @@ TrackerProfile make_nite() {
   p.object_hidden_tracked = 0.6;
   p.near_object_inferred = 0.25;
   p.back_limbs_inferred = 0.2;
+  p.back_shoulders_factor = 0.0;
   p.head_doubt = 0.07;
   p.head_doubt_unusual = 0.35;
   p.elbow_doubt_bent = 0.7;
@@ -425,7 +426,10 @@ std::optional<skeleton::Skeleton> TrackerModel::observe(double t, const Scene& s
       if (near_drop_[j].on) conf = skeleton::kInferred;
     }
     double doubt = 0.0;
-    if (is_arm(jid)) doubt = p_.back_limbs_inferred * back;
+    if (is_arm(jid)) {
+      const bool shoulder = jid == JointId::LeftShoulder || jid == JointId::RightShoulder;
+      doubt = p_.back_limbs_inferred * back * (shoulder ? p_.back_shoulders_factor : 1.0);
+    }
     if (jid == JointId::Head) doubt = p_.head_doubt + p_.head_doubt_unusual * unusual;
     if (jid == JointId::LeftElbow || jid == JointId::RightElbow) {
       doubt += p_.elbow_doubt_bent * bent + p_.elbow_doubt_sitting * sitting;

@@ -34,6 +34,7 @@ struct TrackerProfile {
   double object_hidden_tracked = 0.0;   // ... hidden behind a wall or a box
   double near_object_inferred = 0.0;    // share of time a joint touching an object drops to 0.5
   double back_limbs_inferred = 0.0;     // share of time arm joints drop to 0.5 with the back to the sensor
+  double back_shoulders_factor = 1.0;   // ... times this for the shoulders (NITE keeps them: 360, 100 %)
   double head_doubt = 0.0;              // share of time the head is 0.5 standing upright
   double head_doubt_unusual = 0.0;      // ... added when bent over or sitting
   double elbow_doubt_bent = 0.0;        // share of time elbows are 0.5 when bent over
