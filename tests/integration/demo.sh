@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
-# The main job as a user runs it: `skelgraph demo` evaluates fusion on the
-# simulator, writes the report, runs the live graph (sync, monitor, simulated
-# cell, fusion) and says what it saw.
+# The main job as a user runs it: `skelgraph demo` runs the live graph
+# (simulated two-sensor cell, sync, recorder, fusion with every method),
+# scores the session's recording, evaluates the seven scenarios offline and
+# writes one report.
 source "$(dirname "$0")/lib.sh"
 
-"$SKELGRAPH" demo --duration 4 --json --report "$WORK/report" >"$WORK/demo.json" 2>"$WORK/demo.err" ||
+"$SKELGRAPH" demo --duration 6 --json --report "$WORK/report" >"$WORK/demo.json" 2>"$WORK/demo.err" ||
   fail "demo: $(tail -5 "$WORK/demo.err")"
+grep -q "\[demo 3/3\]" "$WORK/demo.err" || fail "demo shows no progress: $(head -c 2000 "$WORK/demo.err")"
 python3 - "$WORK/demo.json" <<'PY' || fail "demo report: $(head -c 3000 "$WORK/demo.json")"
 import json, os, sys
 d = json.load(open(sys.argv[1]))
@@ -13,11 +15,26 @@ assert os.path.getsize(d["report"]) > 10000, d["report"]
 html = open(d["report"]).read()
 for s in ("walk", "360", "hide", "box", "occ", "sit", "arms"):
     assert "<h2>%s (2 sensors" % s in html, s
+assert "<h2>live graph" in html
 c = {x["name"]: x for x in d["components"]}
 assert all(x["state"] == "OK" for x in c.values()), {k: (v["state"], v["message"]) for k, v in c.items()}
-assert c["fusion"]["details"]["published"] > 60 and c["fusion"]["details"]["tick_steps"] > 60, c["fusion"]["details"]
+methods = ("avg", "sum", "facing", "weighted", "kalman")
+for m in methods:
+    det = c["fusion_" + m]["details"]
+    assert det["published"] > 60 and det["tick_steps"] > 60, (m, det)
 sess = d["seen"]["sessions"]
 assert sess and sess[0]["ticks"] > 90 and sess[0]["saw_stop"], sess
-print("report %s; fused %d skeletons on %d ticks" % (d["report"], c["fusion"]["details"]["published"], sess[0]["ticks"]))
+assert os.path.exists(d["recording"]), d["recording"]
+live = d["live_evaluation"]
+assert live["on_sync_ticks"] and live["truth_skeletons"] > 100, live
+streams = {s["stream"]: s for s in live["streams"]}
+for m in methods:
+    # Every method re-run offline and as recorded live, scored against the truth.
+    for name in (m, "live " + m):
+        assert streams[name]["ticks_with_output"] > 60 and streams[name]["mean_error_cm"] is not None, (name, streams.get(name))
+# What the live kalman component published is what the offline re-run computes, give or take a tick.
+off, on = streams["kalman"]["mean_error_cm"], streams["live kalman"]["mean_error_cm"]
+assert abs(off - on) < 0.25 * off + 1.0, (off, on)
+print("report %s; recording %s; kalman offline %.1f cm, live %.1f cm" % (d["report"], d["recording"], off, on))
 PY
-ok "demo: report for the seven scenarios, live graph OK, fusion on the sync ticks"
+ok "demo: live graph (every method) recorded and scored, seven scenarios, one report"

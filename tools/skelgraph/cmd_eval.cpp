@@ -124,7 +124,7 @@ std::string report_section(const std::string& dir, const std::string& name, cons
       xyz.push_back(std::move(truth));
     }
     for (const auto& s : r.streams) {
-      if (s.fused && s.name != "kalman" && s.name != "avg") continue;
+      if (s.fused && s.name != "kalman" && s.name != "avg" && s.name != "live kalman") continue;
       report::Series se{s.name, secs(s), {}};
       for (const auto& p : s.trace) se.y.push_back(p.joint[axis]);
       xyz.push_back(std::move(se));
@@ -143,13 +143,34 @@ std::string report_section(const std::string& dir, const std::string& name, cons
   return h.str();
 }
 
+// DIR/report.html around the given sections; returns its path.
+std::string write_report_page(const std::string& dir, const std::string& heading, const std::string& sections) {
+  const auto path = std::filesystem::path(dir) / "report.html";
+  std::ofstream f(path);
+  f << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>" << report::html_escape(heading)
+    << "</title><style>"
+       "body{font-family:sans-serif;margin:2em;max-width:1100px}table{border-collapse:collapse;font-size:12px}"
+       "td,th{border:1px solid #ccc;padding:2px 6px;text-align:right}td:first-child{text-align:left}"
+       "figure{margin:1em 0}</style></head><body>\n<h1>"
+    << report::html_escape(heading)
+    << "</h1>\n"
+       "<p>Detection: % of output ticks (the sync ticks, else 30 Hz) a joint group is reported with confidence 1. "
+       "Error: mean distance to truth over those, cm. Single sensors are scored on the same ticks as the fusion "
+       "methods; 'offsets removed': after the first 5 s, each stream's constant per-joint offsets (learnt in the "
+       "body frame while the person stands still) subtracted. Made by <code>skelgraph eval ... --report</code>; "
+       "every figure is also an SVG file in this directory.</p>\n"
+    << sections << "</body></html>\n";
+  if (!f.flush()) throw std::runtime_error("cannot write " + path.string());
+  return path.string();
+}
+
 // A recording's raw skeletons, truth (both at their log time, the recorder's
 // clock) and sensor poses (the latest per sensor in the file).
 struct RecordingInputs {
   std::map<std::string, Eigen::Isometry3d> poses;
   std::vector<eval::TimedSkeleton> events;
   std::vector<std::int64_t> ticks;  // log times of the sync TICKs, if the session was synchronised
-  std::uint64_t raw = 0, truth = 0;
+  std::uint64_t raw = 0, truth = 0, fused = 0;  // fused: recorded live fusion output
 };
 
 // shared_frame: every sensor's skeletons are already in one frame (data sets
@@ -171,11 +192,14 @@ RecordingInputs read_recording(const std::string& file, bool shared_frame) {
       } else if (schema->name == msg::MessageTraits<msg::Skeleton>::name) {
         const bool raw = ch.topic == runtime::topics::kSkeletonRaw.name;
         const bool truth = ch.topic == runtime::topics::kSkeletonTruth.name;
-        if (!raw && !truth) return;
-        in.events.push_back({raw ? eval::TimedSkeleton::Kind::Raw : eval::TimedSkeleton::Kind::Truth,
+        const bool fused = ch.topic == runtime::topics::kSkeletonFused.name;
+        if (!raw && !truth && !fused) return;
+        in.events.push_back({raw     ? eval::TimedSkeleton::Kind::Raw
+                             : truth ? eval::TimedSkeleton::Kind::Truth
+                                     : eval::TimedSkeleton::Kind::Fused,
                              static_cast<std::int64_t>(m.log_time),
                              skeleton::from_msg(msg::from_cdr<msg::Skeleton>(bytes, m.data.size()))});
-        ++(raw ? in.raw : in.truth);
+        ++(raw ? in.raw : truth ? in.truth : in.fused);
       }
     });
   } catch (const mcap::McapError& e) {
@@ -196,7 +220,7 @@ RecordingInputs read_recording(const std::string& file, bool shared_frame) {
 }
 
 struct FileOptions {
-  std::string file, out;
+  std::string file, out, report_dir;
   std::vector<std::string> methods;
   double delay_ms = 0, max_age_ms = 100;
   bool json = false, shared_frame = false;
@@ -223,23 +247,36 @@ eval::OfflineOptions offline_options(const FileOptions& o, const RecordingInputs
 // recording if it has one; bone-length steadiness and completeness either way.
 int eval_file(const FileOptions& o) {
   const auto in = read_recording(o.file, o.shared_frame);
-  const auto r = eval::evaluate(in.poses, in.events, offline_options(o, in));
+  auto eo = offline_options(o, in);
+  eo.trace = !o.report_dir.empty();
+  const auto r = eval::evaluate(in.poses, in.events, eo);
   nlohmann::json streams = nlohmann::json::array();
   for (const auto& s : r.streams) streams.push_back(stream_json(s));
+  std::string report_path;
+  if (eo.trace) {
+    std::filesystem::create_directories(o.report_dir);
+    const auto name = std::filesystem::path(o.file).stem().string();
+    report_path = write_report_page(o.report_dir, "skelgraph: " + name,
+                                    report_section(o.report_dir, name, name, r, "right_hand"));
+  }
+  nlohmann::json j{{"file", o.file},  {"has_truth", r.has_truth}, {"ticks", r.ticks},
+                   {"on_sync_ticks", !in.ticks.empty()}, {"raw_skeletons", in.raw},
+                   {"truth_skeletons", in.truth}, {"live_fused_skeletons", in.fused}, {"streams", streams}};
+  if (!report_path.empty()) j["report"] = report_path;
   if (o.json) {
-    std::printf("%s\n", nlohmann::json{{"file", o.file}, {"has_truth", r.has_truth}, {"ticks", r.ticks},
-                                       {"on_sync_ticks", !in.ticks.empty()},
-                                       {"raw_skeletons", in.raw}, {"truth_skeletons", in.truth}, {"streams", streams}}
-                            .dump(2)
-                            .c_str());
+    std::printf("%s\n", j.dump(2).c_str());
   } else {
-    std::printf("## %s\n\n%llu raw skeletons from %zu sensor(s), %llu truth skeletons, %llu output ticks (%s)\n",
+    std::printf("## %s\n\n%llu raw skeletons from %zu sensor(s), %llu truth skeletons, %llu live fused skeletons, "
+                "%llu output ticks (%s)\n",
                 o.file.c_str(), static_cast<unsigned long long>(in.raw), in.poses.size(),
-                static_cast<unsigned long long>(in.truth), static_cast<unsigned long long>(r.ticks),
-                in.ticks.empty() ? "30 Hz" : "the recording's sync ticks");
+                static_cast<unsigned long long>(in.truth), static_cast<unsigned long long>(in.fused),
+                static_cast<unsigned long long>(r.ticks), in.ticks.empty() ? "30 Hz" : "the recording's sync ticks");
     if (!r.has_truth) std::printf("No ground truth in the recording: detection and error columns are empty; "
                                   "upper-body completeness and bone-length SD need none.\n");
+    if (in.fused > 0) std::printf("'live <id>': what a fusion component published live, as received by the recorder "
+                                  "(scored at each tick against its latest output, so one tick behind).\n");
     print_table(o.file, r);
+    if (!report_path.empty()) std::printf("\nreport: %s\n", report_path.c_str());
   }
   return 0;
 }
@@ -303,6 +340,22 @@ int fuse_file(const FileOptions& o) {
 
 }  // namespace
 
+RecordingReport eval_recording_section(const std::string& file, const std::string& report_dir, const std::string& title) {
+  FileOptions o;
+  o.file = file;
+  const auto in = read_recording(file, false);
+  auto eo = offline_options(o, in);
+  eo.trace = true;
+  const auto r = eval::evaluate(in.poses, in.events, eo);
+  RecordingReport out;
+  out.summary = {{"file", file}, {"ticks", r.ticks}, {"on_sync_ticks", !in.ticks.empty()}, {"raw_skeletons", in.raw},
+                 {"truth_skeletons", in.truth}, {"live_fused_skeletons", in.fused}, {"streams", nlohmann::json::array()}};
+  for (const auto& s : r.streams) out.summary["streams"].push_back(stream_json(s));
+  std::filesystem::create_directories(report_dir);
+  out.html = report_section(report_dir, "live", title, r, "right_hand");
+  return out;
+}
+
 int eval_sim(const SimEvalOptions& o) {
   runtime::ParamSchema schema;
   sim::add_sim_params(schema);
@@ -357,18 +410,9 @@ int eval_sim(const SimEvalOptions& o) {
     if (eo.trace) html += report_section(o.report_dir, scenario, title, r, "right_hand");
   }
   if (eo.trace) {
-    const auto path = std::filesystem::path(o.report_dir) / "report.html";
-    std::ofstream f(path);
-    f << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>skelgraph fusion report</title><style>"
-         "body{font-family:sans-serif;margin:2em;max-width:1100px}table{border-collapse:collapse;font-size:12px}"
-         "td,th{border:1px solid #ccc;padding:2px 6px;text-align:right}td:first-child{text-align:left}"
-         "figure{margin:1em 0}</style></head><body>\n<h1>skelgraph: fusion against ground truth (simulator)</h1>\n"
-         "<p>Detection: % of 30 Hz output ticks a joint group is reported with confidence 1. Error: mean distance to "
-         "truth over those, cm. Single sensors are scored on the same ticks as the fusion methods. Made by "
-         "<code>skelgraph eval sim --report</code>; every figure is also an SVG file in this directory.</p>\n"
-      << html << "</body></html>\n";
-    if (!f.flush()) throw std::runtime_error("cannot write " + path.string());
-    if (!o.json && !o.quiet) std::printf("\nreport: %s\n", path.string().c_str());
+    const auto path = write_report_page(o.report_dir, "skelgraph: fusion against ground truth",
+                                        o.extra_html + html);
+    if (!o.json && !o.quiet) std::printf("\nreport: %s\n", path.c_str());
   }
   if (o.json && !o.quiet) {
     std::printf("%s\n", nlohmann::json{{"delay_ms", o.delay_ms}, {"max_age_ms", o.max_age_ms}, {"scenarios", out}}
@@ -425,6 +469,7 @@ void add_eval_command(CLI::App& app, GlobalOptions&, Action& run) {
   add_fusion_options(r, fo->methods, fo->delay_ms, fo->max_age_ms, "fusion methods (default: all)");
   r->add_flag("--json", fo->json, "machine-readable results");
   r->add_flag("--shared-frame", fo->shared_frame, "the sensors' skeletons are already in one frame (e.g. KinectMultiTrack): no poses needed");
+  r->add_option("--report", fo->report_dir, "also write DIR/report.html (table, inline SVG plots) and each plot as SVG");
   r->callback([fo, &run] { run = [fo] { return eval_file(*fo); }; });
 }
 

@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 namespace skelgraph::cli {
 
 struct SimEvalOptions {
@@ -13,9 +15,19 @@ struct SimEvalOptions {
   bool json = false;
   bool quiet = false;  // nothing on stdout (progress still on stderr)
   std::string report_dir;
+  std::string extra_html;  // report sections placed before the scenarios' (the demo's live recording)
 };
 
 // Prints the tables (Markdown, or JSON with `json`), writes the report when report_dir is set.
 int eval_sim(const SimEvalOptions& o);
+
+// A recording scored as `skelgraph eval recording` does (single sensors, every
+// method re-run offline, and the live fusion streams it recorded), for a report:
+// its figures go to report_dir, its section's HTML and the figures as JSON come back.
+struct RecordingReport {
+  nlohmann::json summary;
+  std::string html;
+};
+RecordingReport eval_recording_section(const std::string& file, const std::string& report_dir, const std::string& title);
 
 }  // namespace skelgraph::cli

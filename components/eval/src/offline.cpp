@@ -91,19 +91,21 @@ OfflineResult evaluate(const std::map<std::string, Eigen::Isometry3d>& world_fro
     std::string only_sensor;  // singles: the one sensor fed
     fusion::Method method;
     OffsetModel offsets;
+    std::string recorded;  // a live fusion component's output id: its recorded skeletons, no fuser
+    std::map<std::uint32_t, std::pair<std::int64_t, skeleton::Skeleton>> latest;  // recorded: per person
   };
   std::vector<Lane> lanes;
-  std::vector<std::string> sensor_ids;
+  std::vector<std::string> sensor_ids, recorded_ids;
   for (const auto& e : events) {
-    if (e.kind == TimedSkeleton::Kind::Raw &&
-        std::find(sensor_ids.begin(), sensor_ids.end(), e.skeleton.sensor_id) == sensor_ids.end()) {
-      sensor_ids.push_back(e.skeleton.sensor_id);
+    auto& ids = e.kind == TimedSkeleton::Kind::Raw ? sensor_ids : recorded_ids;
+    if (e.kind != TimedSkeleton::Kind::Truth && std::find(ids.begin(), ids.end(), e.skeleton.sensor_id) == ids.end()) {
+      ids.push_back(e.skeleton.sensor_id);
     }
   }
   auto make_lane = [&](const std::string& name, bool fused, fusion::Method m, const std::string& only) {
     auto fo = options.fuser;
     fo.method = m;
-    Lane lane{{}, fusion::Fuser(fo), only, m, {}};
+    Lane lane{{}, fusion::Fuser(fo), only, m, {}, {}, {}};
     lane.score.name = name;
     lane.score.fused = fused;
     for (const auto& [id, pose] : world_from_sensor) lane.fuser.set_pose(id, pose);
@@ -113,6 +115,10 @@ OfflineResult evaluate(const std::map<std::string, Eigen::Isometry3d>& world_fro
     for (const auto& id : sensor_ids) make_lane(id, false, fusion::Method::Avg, id);
   }
   for (const auto m : options.methods) make_lane(fusion::method_name(m), true, m, "");
+  for (const auto& id : recorded_ids) {
+    make_lane("live " + id, true, fusion::Method::Avg, "");
+    lanes.back().recorded = id;
+  }
 
   OfflineResult result;
   TruthTimeline truth;
@@ -125,7 +131,7 @@ OfflineResult evaluate(const std::map<std::string, Eigen::Isometry3d>& world_fro
       if (!any_truth || e.t_ns < first_truth) first_truth = e.t_ns;
       any_truth = true;
       result.has_truth = true;
-    } else {
+    } else if (e.kind == TimedSkeleton::Kind::Raw) {
       if (!any_raw) first = e.t_ns;
       last = std::max(last, e.t_ns);
       any_raw = true;
@@ -141,8 +147,14 @@ OfflineResult evaluate(const std::map<std::string, Eigen::Isometry3d>& world_fro
     // Everything that arrived up to this tick goes in first.
     for (; next < events.size() && events[next].t_ns <= tick; ++next) {
       const auto& e = events[next];
+      if (e.kind == TimedSkeleton::Kind::Fused) {
+        for (auto& lane : lanes) {
+          if (lane.recorded == e.skeleton.sensor_id) lane.latest[e.skeleton.person_id] = {e.t_ns, e.skeleton};
+        }
+      }
       if (e.kind != TimedSkeleton::Kind::Raw) continue;
       for (auto& lane : lanes) {
+        if (!lane.recorded.empty()) continue;
         if (lane.only_sensor.empty() || lane.only_sensor == e.skeleton.sensor_id) lane.fuser.add(e.skeleton, e.t_ns);
       }
     }
@@ -150,9 +162,22 @@ OfflineResult evaluate(const std::map<std::string, Eigen::Isometry3d>& world_fro
     const std::int64_t at = tick - options.fuser.delay_ns;
     const bool truth_here = truth.covers(at);
     for (auto& lane : lanes) {
-      const auto fused = lane.fuser.fuse(tick);
+      std::vector<skeleton::Skeleton> fused;
+      if (lane.recorded.empty()) {
+        fused = lane.fuser.fuse(tick);
+      } else {
+        // What the live component last published for each person, if recent.
+        for (auto it = lane.latest.begin(); it != lane.latest.end();) {
+          if (tick - it->second.first > options.fuser.max_age_ns) {
+            it = lane.latest.erase(it);
+          } else {
+            fused.push_back(it->second.second);
+            ++it;
+          }
+        }
+      }
       ++lane.score.ticks;
-      if (sink && lane.only_sensor.empty()) {
+      if (sink && lane.only_sensor.empty() && lane.recorded.empty()) {
         for (const auto& f : fused) sink(lane.method, f);
       }
       if (!fused.empty()) ++lane.score.with_output;

@@ -177,7 +177,7 @@ nlohmann::json SimComponent::details() const {
           {"truth_published", truth_published_},
           {"raw_published", raw_published_},
           {"runs_completed", runs_completed_},
-          {"finished", finished_}};
+          {"finished", finished_.load()}};
 }
 
 std::string SimComponent::summary() const {

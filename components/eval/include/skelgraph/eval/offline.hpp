@@ -22,10 +22,12 @@
 namespace skelgraph::eval {
 
 struct TimedSkeleton {
-  enum class Kind { Raw, Truth };
+  // Fused: what a live fusion component published (scored as the stream
+  // "live <sensor_id>", beside the offline re-runs of every method).
+  enum class Kind { Raw, Truth, Fused };
   Kind kind = Kind::Raw;
-  std::int64_t t_ns = 0;       // arrival (raw) or truth time, on one clock
-  skeleton::Skeleton skeleton;  // raw: its sensor's frame; truth: world
+  std::int64_t t_ns = 0;       // arrival (raw, fused) or truth time, on one clock
+  skeleton::Skeleton skeleton;  // raw: its sensor's frame; truth and fused: world
 };
 
 struct OfflineOptions {
@@ -63,7 +65,7 @@ struct StreamScore {
 };
 
 struct OfflineResult {
-  std::vector<StreamScore> streams;  // singles first (sensor order), then methods
+  std::vector<StreamScore> streams;  // singles first (sensor order), then methods, then recorded live fusion
   std::uint64_t ticks = 0;
   bool has_truth = false;
   std::vector<fusion::FuserStats> fuser_stats;  // per stream

@@ -4,6 +4,7 @@
 // each virtual sensor's tracker output on skelgraph/skeleton/raw (sensor frame,
 // sensor clock) and the sensors' true poses on skelgraph/calibration.
 
+#include <atomic>
 #include <memory>
 
 #include "skelgraph/runtime/component.hpp"
@@ -18,6 +19,9 @@ class SimComponent final : public runtime::Component {
   static runtime::ComponentInfo describe();
 
   void on_start() override;
+  // Without `loop` the run has an end: the scenario's (a graph run stops once every such component is done).
+  bool finite() const override { return !loop_; }
+  bool finished() const override { return finished_; }
   std::string summary() const override;
   nlohmann::json details() const override;
 
@@ -40,7 +44,7 @@ class SimComponent final : public runtime::Component {
   bool publishes(std::size_t sensor) const;
   double loop_offset_s_ = 0.0;  // world time at which the current run started
   std::uint64_t truth_published_ = 0, raw_published_ = 0, runs_completed_ = 0;
-  bool finished_ = false;
+  std::atomic<bool> finished_{false};
 };
 
 // Builds the simulation's configuration from the component's parameters
