@@ -112,6 +112,7 @@ int main(int argc, char** argv) {
   add_sim_command(app, g, run);
   add_bag_command(app, g, run);
   add_eval_command(app, g, run);
+  add_calib_command(app, g, run);
   add_fuse_command(app, g, run);
   try {
     app.parse(argc, argv);

@@ -1,0 +1,42 @@
+#pragma once
+// Calibration files (YAML, under bringup/calib/ by convention): the pose of
+// each sensor in one frame, how it was found and how well it fits.
+//
+//   # written by skelgraph calib skeleton ...
+//   version: 1
+//   frame_id: world
+//   sensors:
+//     - id: sensor1
+//       translation: [0.0, 0.0, 0.0]          # m, frame_id <- sensor
+//       rotation_xyzw: [0.0, 0.0, 0.0, 1.0]   # unit quaternion
+//       method: skeleton                      # ground_truth | checkerboard | skeleton | manual
+//       rms_residual_m: 0.0
+//       max_residual_m: 0.0
+//
+// The `calibration` component publishes it on skelgraph/calibration, where
+// fusion takes its sensor poses from.
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "skelgraph/skeleton/skeleton_msg.hpp"
+
+namespace skelgraph::calib {
+
+class CalibFileError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct CalibFile {
+  std::string frame_id = "world";
+  std::vector<skeleton::SensorPose> sensors;
+  std::string comment;  // first-line comment when writing (what made it)
+};
+
+// Throws CalibFileError naming file:line and what was expected.
+CalibFile read_calib_file(const std::string& path);
+void write_calib_file(const std::string& path, const CalibFile& file);
+
+}  // namespace skelgraph::calib

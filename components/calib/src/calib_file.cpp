@@ -1,0 +1,101 @@
+#include "skelgraph/calib/calib_file.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <yaml-cpp/yaml.h>
+
+namespace skelgraph::calib {
+
+namespace {
+
+[[noreturn]] void fail(const std::string& path, const YAML::Node& n, const std::string& what) {
+  const auto m = n.Mark();
+  throw CalibFileError(path + (m.is_null() ? "" : ":" + std::to_string(m.line + 1) + ":" + std::to_string(m.column + 1)) +
+                       ": " + what);
+}
+
+std::vector<double> numbers(const std::string& path, const YAML::Node& n, const char* key, std::size_t count) {
+  const auto v = n[key];
+  if (!v) fail(path, n, std::string("missing '") + key + "'");
+  if (!v.IsSequence() || v.size() != count) fail(path, v, std::string("'") + key + "' expects a list of " + std::to_string(count) + " numbers");
+  std::vector<double> out;
+  for (const auto& x : v) {
+    double d = 0;
+    try {
+      d = x.as<double>();
+    } catch (const YAML::Exception&) {
+      fail(path, x, std::string("'") + key + "' expects numbers, got '" + x.as<std::string>("?") + "'");
+    }
+    if (!std::isfinite(d)) fail(path, x, std::string("'") + key + "' expects finite numbers");
+    out.push_back(d);
+  }
+  return out;
+}
+
+}  // namespace
+
+CalibFile read_calib_file(const std::string& path) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    throw CalibFileError(path + ": cannot read the file");
+  } catch (const YAML::ParserException& e) {
+    throw CalibFileError(path + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) + ": " + e.msg);
+  }
+  if (!root.IsMap()) fail(path, root, "expected a mapping with 'version', 'frame_id' and 'sensors'");
+  if (!root["version"] || root["version"].as<std::string>("") != "1") {
+    fail(path, root["version"] ? root["version"] : root, "expected 'version: 1'");
+  }
+  CalibFile f;
+  if (root["frame_id"]) f.frame_id = root["frame_id"].as<std::string>();
+  const auto sensors = root["sensors"];
+  if (!sensors || !sensors.IsSequence() || sensors.size() == 0) fail(path, sensors ? sensors : root, "expected 'sensors': a non-empty list");
+  for (const auto& s : sensors) {
+    if (!s.IsMap() || !s["id"]) fail(path, s, "each sensor needs an 'id'");
+    skeleton::SensorPose p;
+    p.sensor_id = s["id"].as<std::string>();
+    p.frame_id = f.frame_id;
+    const auto t = numbers(path, s, "translation", 3);
+    const auto q = numbers(path, s, "rotation_xyzw", 4);
+    Eigen::Quaterniond quat(q[3], q[0], q[1], q[2]);
+    if (std::abs(quat.norm() - 1.0) > 1e-3) fail(path, s["rotation_xyzw"], "'rotation_xyzw' is not a unit quaternion (norm " + std::to_string(quat.norm()) + ")");
+    p.pose = Eigen::Isometry3d::Identity();
+    p.pose.linear() = quat.normalized().toRotationMatrix();
+    p.pose.translation() = Eigen::Vector3d(t[0], t[1], t[2]);
+    p.method = s["method"] ? s["method"].as<std::string>() : "manual";
+    p.rms_residual_m = s["rms_residual_m"] ? s["rms_residual_m"].as<double>() : 0.0;
+    p.max_residual_m = s["max_residual_m"] ? s["max_residual_m"].as<double>() : 0.0;
+    for (const auto& other : f.sensors) {
+      if (other.sensor_id == p.sensor_id) fail(path, s["id"], "sensor '" + p.sensor_id + "' is listed twice");
+    }
+    f.sensors.push_back(std::move(p));
+  }
+  return f;
+}
+
+void write_calib_file(const std::string& path, const CalibFile& f) {
+  YAML::Emitter e;
+  e.SetDoublePrecision(9);
+  e << YAML::BeginMap << YAML::Key << "version" << YAML::Value << 1 << YAML::Key << "frame_id" << YAML::Value
+    << f.frame_id << YAML::Key << "sensors" << YAML::Value << YAML::BeginSeq;
+  for (const auto& p : f.sensors) {
+    const Eigen::Quaterniond q(p.pose.rotation());
+    const Eigen::Vector3d t = p.pose.translation();
+    e << YAML::BeginMap << YAML::Key << "id" << YAML::Value << p.sensor_id;
+    e << YAML::Key << "translation" << YAML::Value << YAML::Flow << std::vector<double>{t.x(), t.y(), t.z()};
+    e << YAML::Key << "rotation_xyzw" << YAML::Value << YAML::Flow << std::vector<double>{q.x(), q.y(), q.z(), q.w()};
+    e << YAML::Key << "method" << YAML::Value << p.method;
+    e << YAML::Key << "rms_residual_m" << YAML::Value << p.rms_residual_m;
+    e << YAML::Key << "max_residual_m" << YAML::Value << p.max_residual_m << YAML::EndMap;
+  }
+  e << YAML::EndSeq << YAML::EndMap;
+  std::ofstream out(path);
+  if (!f.comment.empty()) out << "# " << f.comment << "\n";
+  out << e.c_str() << "\n";
+  if (!out.flush()) throw CalibFileError(path + ": cannot write the file");
+}
+
+}  // namespace skelgraph::calib

@@ -1,0 +1,313 @@
+#include "skelgraph/calib/skeleton_calib.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <optional>
+#include <random>
+
+namespace skelgraph::calib {
+
+using Eigen::Vector3d;
+using skeleton::JointId;
+using skeleton::Skeleton;
+
+double median(std::vector<double> v) {
+  if (v.empty()) return std::nan("");
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+namespace {
+
+const std::vector<JointId>& default_joints() {
+  static const std::vector<JointId> j{JointId::Head,      JointId::Neck,          JointId::Torso,
+                                      JointId::LeftShoulder, JointId::RightShoulder, JointId::LeftElbow,
+                                      JointId::RightElbow,  JointId::LeftHand,      JointId::RightHand,
+                                      JointId::LeftHip,     JointId::RightHip};
+  return j;
+}
+
+bool tracked(const Skeleton& s, JointId j) {
+  const auto& x = s[j];
+  return x.confidence >= skeleton::kTracked && x.position.allFinite();
+}
+
+using Track = std::vector<const TimedSkeleton*>;  // one person of one sensor, in time order
+
+std::map<std::uint32_t, Track> tracks_of(const std::vector<TimedSkeleton>& v) {
+  std::map<std::uint32_t, Track> out;
+  for (const auto& s : v) out[s.skeleton.person_id].push_back(&s);
+  for (auto& [id, tr] : out) {
+    std::stable_sort(tr.begin(), tr.end(), [](auto* a, auto* b) { return a->t_ns < b->t_ns; });
+  }
+  return out;
+}
+
+// The person at t, linearly interpolated between the frames around it (no
+// further apart than max_gap); a joint is tracked only if it is in both.
+std::optional<Skeleton> at(const Track& tr, std::int64_t t, std::int64_t max_gap) {
+  auto it = std::lower_bound(tr.begin(), tr.end(), t, [](const TimedSkeleton* s, std::int64_t x) { return s->t_ns < x; });
+  if (it != tr.end() && (*it)->t_ns == t) return (*it)->skeleton;
+  if (it == tr.begin() || it == tr.end()) return std::nullopt;
+  const TimedSkeleton* b = *it;
+  const TimedSkeleton* a = *(it - 1);
+  if (b->t_ns - a->t_ns > max_gap) return std::nullopt;
+  const double u = static_cast<double>(t - a->t_ns) / static_cast<double>(b->t_ns - a->t_ns);
+  Skeleton s = a->skeleton;
+  for (std::size_t j = 0; j < skeleton::kJointCount; ++j) {
+    const auto& ja = a->skeleton.joints[j];
+    const auto& jb = b->skeleton.joints[j];
+    s.joints[j].position = (1 - u) * ja.position + u * jb.position;
+    s.joints[j].confidence = std::min(ja.confidence, jb.confidence);
+  }
+  return s;
+}
+
+// One reference person-frame and what the other sensor saw at that moment.
+struct Candidate {
+  const Skeleton* ref;
+  std::vector<Skeleton> others;
+};
+
+std::vector<Candidate> candidates(const std::vector<TimedSkeleton>& reference, const std::map<std::uint32_t, Track>& other,
+                                  std::int64_t offset, std::int64_t max_gap) {
+  std::vector<Candidate> out;
+  for (const auto& r : reference) {
+    Candidate c{&r.skeleton, {}};
+    for (const auto& [id, tr] : other) {
+      if (auto s = at(tr, r.t_ns - offset, max_gap)) c.others.push_back(std::move(*s));
+    }
+    if (!c.others.empty()) out.push_back(std::move(c));
+  }
+  return out;
+}
+
+// How one of the other sensor's skeletons fits a reference one under a pose,
+// as seen or with its sides swapped.
+struct Fit {
+  std::size_t agree = 0;  // joints within the threshold
+  double median_m = std::numeric_limits<double>::infinity();
+  std::size_t other = 0;
+  bool swapped = false;
+};
+
+Fit fit_of(const Candidate& c, const Alignment& pose, const std::vector<JointId>& joints, double thr) {
+  Fit best;
+  std::vector<double> d;
+  for (std::size_t o = 0; o < c.others.size(); ++o) {
+    for (const bool swapped : {false, true}) {
+      d.clear();
+      std::size_t agree = 0;
+      for (const auto j : joints) {
+        const JointId oj = swapped ? skeleton::mirror(j) : j;
+        if (!tracked(*c.ref, j) || !tracked(c.others[o], oj)) continue;
+        const double e = (pose.apply(c.others[o][oj].position) - (*c.ref)[j].position).norm();
+        d.push_back(e);
+        agree += e <= thr ? 1 : 0;
+      }
+      if (d.size() < 3) continue;
+      const double m = median(d);
+      if (agree > best.agree || (agree == best.agree && m < best.median_m)) best = {agree, m, o, swapped};
+    }
+  }
+  return best;
+}
+
+struct Pairs {
+  std::vector<Vector3d> other, ref;
+  std::vector<JointId> joint;
+  std::size_t matched = 0, flipped = 0;
+};
+
+Pairs pair_up(const std::vector<Candidate>& cs, const Alignment& pose, const std::vector<JointId>& joints,
+              const SkeletonCalibOptions& o) {
+  Pairs p;
+  for (const auto& c : cs) {
+    const Fit f = fit_of(c, pose, joints, o.inlier_threshold_m);
+    if (!(f.median_m <= o.match_median_m)) continue;
+    if (f.swapped) {
+      ++p.flipped;  // one of the two sees the person's back and swapped left and right
+      continue;
+    }
+    ++p.matched;
+    for (const auto j : joints) {
+      if (!tracked(*c.ref, j) || !tracked(c.others[f.other], j)) continue;
+      p.other.push_back(c.others[f.other][j].position);
+      p.ref.push_back((*c.ref)[j].position);
+      p.joint.push_back(j);
+    }
+  }
+  return p;
+}
+
+// Frame-level RANSAC: a pose from one frame's joints, scored on (a spread of) all frames.
+Alignment propose(const std::vector<Candidate>& cs, const std::vector<JointId>& joints, const SkeletonCalibOptions& o) {
+  std::vector<const Candidate*> scored;
+  const std::size_t step = std::max<std::size_t>(1, cs.size() / std::max<std::size_t>(1, o.max_scored_frames));
+  for (std::size_t i = 0; i < cs.size(); i += step) scored.push_back(&cs[i]);
+  std::mt19937_64 rng(o.seed);
+  std::uniform_int_distribution<std::size_t> pick(0, cs.size() - 1);
+  Alignment best;
+  std::size_t best_score = 0;
+  double best_med = std::numeric_limits<double>::infinity();
+  for (int h = 0; h < o.hypotheses; ++h) {
+    const Candidate& c = cs[pick(rng)];
+    const Skeleton& other = c.others[std::uniform_int_distribution<std::size_t>(0, c.others.size() - 1)(rng)];
+    std::vector<Vector3d> a, b;
+    for (const auto j : joints) {
+      if (tracked(*c.ref, j) && tracked(other, j)) a.push_back(other[j].position), b.push_back((*c.ref)[j].position);
+    }
+    if (a.size() < 4) continue;
+    Alignment pose;
+    try {
+      pose = align(a, b);
+    } catch (const CalibError&) {
+      continue;
+    }
+    std::size_t score = 0;
+    std::vector<double> meds;
+    for (const auto* s : scored) {
+      const Fit f = fit_of(*s, pose, joints, o.inlier_threshold_m);
+      score += f.agree;
+      if (std::isfinite(f.median_m)) meds.push_back(f.median_m);
+    }
+    const double med = median(meds);
+    if (score > best_score || (score == best_score && med < best_med)) {
+      best = pose;
+      best_score = score;
+      best_med = med;
+    }
+  }
+  if (best_score == 0) throw CalibError("no frame gave a pose that any other frame agrees with");
+  return best;
+}
+
+// Pair, solve, repeat until the pose settles; the last round's figures. The
+// pose from a single frame is already robust (it won the frame-level RANSAC),
+// so each round refits on the joint pairs within the threshold of the
+// current pose (a minimal-sample RANSAC over single joints would be at the
+// mercy of a few centimetres of noise on three points).
+SkeletonCalibResult solve(const std::vector<Candidate>& cs, Alignment pose, const std::vector<JointId>& joints,
+                          const SkeletonCalibOptions& o) {
+  SkeletonCalibResult r;
+  for (int round = 0; round < 20; ++round) {
+    const Pairs p = pair_up(cs, pose, joints, o);
+    std::vector<Vector3d> a, b;
+    std::vector<std::size_t> idx;
+    for (std::size_t i = 0; i < p.ref.size(); ++i) {
+      if ((pose.apply(p.other[i]) - p.ref[i]).norm() <= o.inlier_threshold_m) {
+        a.push_back(p.other[i]);
+        b.push_back(p.ref[i]);
+        idx.push_back(i);
+      }
+    }
+    if (a.size() < 10) {
+      throw CalibError("only " + std::to_string(a.size()) + " joint pairs agree with the best pose within " +
+                       std::to_string(o.inlier_threshold_m) + " m (" + std::to_string(p.matched) + " frames matched, " +
+                       std::to_string(p.flipped) + " flipped)");
+    }
+    const Alignment fit = align(a, b);
+    const double moved = (fit.t - pose.t).norm() + 0.01 * rotation_angle_deg(fit.R * pose.R.transpose());
+    pose = fit;
+    r.fit = fit;
+    r.reference_frames = cs.size();
+    r.matched = p.matched;
+    r.flipped = p.flipped;
+    r.pairs = p.ref.size();
+    r.inliers = a.size();
+    std::map<JointId, std::vector<double>> per;
+    for (std::size_t k = 0; k < idx.size(); ++k) per[p.joint[idx[k]]].push_back(fit.residuals[k]);
+    r.per_joint.clear();
+    for (const auto j : joints) {
+      auto& v = per[j];
+      JointResidual jr{j, v.size(), median(v), 0.0};
+      double ss = 0;
+      for (double x : v) ss += x * x;
+      jr.rms_m = v.empty() ? std::nan("") : std::sqrt(ss / static_cast<double>(v.size()));
+      r.per_joint.push_back(jr);
+    }
+    if (moved < 1e-5) break;  // 0.01 mm (or 0.001 degree)
+  }
+  return r;
+}
+
+double median_residual(const std::vector<Candidate>& cs, const Alignment& pose, const std::vector<JointId>& joints,
+                       const SkeletonCalibOptions& o) {
+  const Pairs p = pair_up(cs, pose, joints, o);
+  std::vector<double> d;
+  for (std::size_t i = 0; i < p.ref.size(); ++i) d.push_back((pose.apply(p.other[i]) - p.ref[i]).norm());
+  return d.size() < 10 ? std::numeric_limits<double>::infinity() : median(d);
+}
+
+}  // namespace
+
+SkeletonCalibResult calibrate_from_skeletons(const std::vector<TimedSkeleton>& reference,
+                                             const std::vector<TimedSkeleton>& other, const SkeletonCalibOptions& o) {
+  const auto& joints = o.joints.empty() ? default_joints() : o.joints;
+  if (reference.empty() || other.empty()) throw CalibError("need skeletons from both sensors");
+  const auto tracks = tracks_of(other);
+  auto cs = candidates(reference, tracks, 0, o.max_gap_ns);
+  std::int64_t offset = 0;
+  if (o.max_clock_offset_ns > 0) {
+    // A first pose from the frames as they are (a person standing or walking
+    // slowly fits it well enough), then in turn: the offset under which that
+    // pose explains the data best, and the pose at that offset. The first
+    // search spans the whole range in 20 ms steps, the later ones +-30 ms in 2 ms.
+    if (cs.size() < 5) cs = candidates(reference, tracks, 0, 2 * o.max_clock_offset_ns);
+    if (cs.size() < 5) {
+      throw CalibError("the two sensors' skeletons never overlap in time (searched +-" +
+                       std::to_string(o.max_clock_offset_ns / 1'000'000) + " ms)");
+    }
+    Alignment pose = propose(cs, joints, o);
+    for (int round = 0; round < 4; ++round) {
+      const std::int64_t lo = round == 0 ? -o.max_clock_offset_ns : std::max(-o.max_clock_offset_ns, offset - 30'000'000);
+      const std::int64_t hi = round == 0 ? o.max_clock_offset_ns : std::min(o.max_clock_offset_ns, offset + 30'000'000);
+      const std::int64_t step = round == 0 ? 20'000'000 : 2'000'000;
+      double best = std::numeric_limits<double>::infinity();
+      const std::int64_t before = offset;
+      for (std::int64_t off = lo; off <= hi; off += step) {
+        const double m = median_residual(candidates(reference, tracks, off, o.max_gap_ns), pose, joints, o);
+        if (m < best) best = m, offset = off;
+      }
+      if (!std::isfinite(best)) throw CalibError("no clock offset within +-" + std::to_string(o.max_clock_offset_ns / 1'000'000) + " ms lets the skeletons agree");
+      cs = candidates(reference, tracks, offset, o.max_gap_ns);
+      pose = solve(cs, pose, joints, o).fit;
+      if (round > 0 && offset == before) break;
+    }
+  }
+  if (cs.size() < 5) {
+    throw CalibError("only " + std::to_string(cs.size()) +
+                     " reference frames have a skeleton of the other sensor within " +
+                     std::to_string(o.max_gap_ns / 1'000'000) + " ms (do their times overlap? try a clock offset search)");
+  }
+  auto r = solve(cs, propose(cs, joints, o), joints, o);
+  r.clock_offset_ns = offset;
+  return r;
+}
+
+std::vector<double> joint_distances(const std::vector<TimedSkeleton>& reference, const std::vector<TimedSkeleton>& other,
+                                    const Eigen::Isometry3d& reference_from_other, std::int64_t clock_offset_ns,
+                                    const std::vector<JointId>& joints_in, double max_match_m, std::int64_t max_gap_ns) {
+  const auto& joints = joints_in.empty() ? default_joints() : joints_in;
+  std::vector<double> out;
+  for (const auto& c : candidates(reference, tracks_of(other), clock_offset_ns, max_gap_ns)) {
+    double best = std::numeric_limits<double>::infinity();
+    std::vector<double> best_d;
+    for (const auto& o : c.others) {
+      std::vector<double> d;
+      for (const auto j : joints) {
+        if (tracked(*c.ref, j) && tracked(o, j)) d.push_back((reference_from_other * o[j].position - (*c.ref)[j].position).norm());
+      }
+      if (d.empty()) continue;
+      const double m = median(d);
+      if (m < best) best = m, best_d = std::move(d);
+    }
+    if (best <= max_match_m) out.insert(out.end(), best_d.begin(), best_d.end());
+  }
+  return out;
+}
+
+}  // namespace skelgraph::calib

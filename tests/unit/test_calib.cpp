@@ -1,0 +1,250 @@
+// Calibration core: SVD alignment against known transforms (reflection,
+// degenerate input, weights, scale), RANSAC with outliers, and sensor
+// extrinsics from the simulator's skeletons (one and two people, flips,
+// a clock offset).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "skelgraph/calib/rigid.hpp"
+#include "skelgraph/calib/skeleton_calib.hpp"
+#include "skelgraph/sim/simulation.hpp"
+
+using namespace skelgraph;
+using calib::CalibError;
+using Eigen::Matrix3d;
+using Eigen::Vector3d;
+
+namespace {
+
+Matrix3d rot(double yaw_deg, double pitch_deg, double roll_deg) {
+  const double d = M_PI / 180;
+  return (Eigen::AngleAxisd(yaw_deg * d, Vector3d::UnitY()) * Eigen::AngleAxisd(pitch_deg * d, Vector3d::UnitX()) *
+          Eigen::AngleAxisd(roll_deg * d, Vector3d::UnitZ()))
+      .toRotationMatrix();
+}
+
+std::vector<Vector3d> cloud(std::size_t n, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-1.5, 1.5);
+  std::vector<Vector3d> p;
+  for (std::size_t i = 0; i < n; ++i) p.emplace_back(u(rng), u(rng), u(rng));
+  return p;
+}
+
+std::vector<Vector3d> moved(const std::vector<Vector3d>& a, const Matrix3d& R, const Vector3d& t, double s = 1.0) {
+  std::vector<Vector3d> b;
+  for (const auto& x : a) b.push_back(s * (R * x) + t);
+  return b;
+}
+
+template <class F>
+std::string error_of(F&& f) {
+  try {
+    f();
+  } catch (const CalibError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+}  // namespace
+
+TEST(Rigid, RecoversAKnownTransformExactly) {
+  const Matrix3d R = rot(73, -20, 5);
+  const Vector3d t(0.4, -1.2, 3.0);
+  const auto a = cloud(20, 1);
+  const auto f = calib::align(a, moved(a, R, t));
+  EXPECT_LT((f.R - R).norm(), 1e-9);
+  EXPECT_LT((f.t - t).norm(), 1e-9);
+  EXPECT_LT(f.rms, 1e-9);
+  EXPECT_LT(f.max, 1e-9);
+  EXPECT_NEAR(f.R.determinant(), 1.0, 1e-12);
+}
+
+TEST(Rigid, NoiseShowsInTheResiduals) {
+  const Matrix3d R = rot(-120, 10, 0);
+  const Vector3d t(1, 2, 3);
+  const auto a = cloud(500, 2);
+  auto b = moved(a, R, t);
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> n(0, 0.01);
+  for (auto& x : b) x += Vector3d(n(rng), n(rng), n(rng));
+  const auto f = calib::align(a, b);
+  EXPECT_LT(calib::rotation_angle_deg(f.R * R.transpose()), 0.1);
+  EXPECT_LT((f.t - t).norm(), 0.005);
+  EXPECT_NEAR(f.rms, 0.01 * std::sqrt(3.0), 0.002);  // 3-D noise of 1 cm per axis
+  EXPECT_GT(f.max, f.rms);
+}
+
+TEST(Rigid, CoplanarPointsAndAMirrorImageGiveAProperRotation) {
+  // Four points in a plane: Kabsch's SVD may propose a reflection; it must not be returned.
+  const std::vector<Vector3d> a{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}};
+  const Matrix3d R = rot(30, 40, 50);
+  const auto f = calib::align(a, moved(a, R, Vector3d(1, 0, 0)));
+  EXPECT_NEAR(f.R.determinant(), 1.0, 1e-12);
+  EXPECT_LT((f.R - R).norm(), 1e-9);
+  // A mirrored copy of a 3-D cloud has no rotation that matches it: the best proper one, with residuals saying so.
+  const auto c = cloud(30, 4);
+  std::vector<Vector3d> mirrored;
+  for (const auto& x : c) mirrored.emplace_back(-x.x(), x.y(), x.z());
+  const auto m = calib::align(c, mirrored);
+  EXPECT_NEAR(m.R.determinant(), 1.0, 1e-12);
+  EXPECT_GT(m.rms, 0.1);
+}
+
+TEST(Rigid, DegenerateInputIsAClearError) {
+  const std::vector<Vector3d> two{{0, 0, 0}, {1, 0, 0}};
+  EXPECT_NE(error_of([&] { calib::align(two, two); }).find("at least 3"), std::string::npos);
+  const std::vector<Vector3d> line{{0, 0, 0}, {1, 1, 1}, {2, 2, 2}, {3, 3, 3}};
+  EXPECT_NE(error_of([&] { calib::align(line, line); }).find("collinear"), std::string::npos);
+  const std::vector<Vector3d> same{{1, 1, 1}, {1, 1, 1}, {1, 1, 1}};
+  EXPECT_NE(error_of([&] { calib::align(same, same); }).find("coincide"), std::string::npos);
+  auto a = cloud(5, 5);
+  auto b = a;
+  b[3].y() = std::nan("");
+  EXPECT_NE(error_of([&] { calib::align(a, b); }).find("pair 3 is not finite"), std::string::npos);
+  EXPECT_NE(error_of([&] { calib::align(a, cloud(6, 5)); }).find("differ in size"), std::string::npos);
+  EXPECT_NE(error_of([&] { calib::align(a, a, {1, 1, -1, 1, 1}); }).find("negative"), std::string::npos);
+  EXPECT_NE(error_of([&] { calib::align(a, a, {1, 1, 0, 0, 0}); }).find("weight > 0"), std::string::npos);
+}
+
+TEST(Rigid, WeightsAndScale) {
+  const Matrix3d R = rot(10, 20, 30);
+  const Vector3d t(-1, 0.5, 2);
+  const auto a = cloud(12, 6);
+  auto b = moved(a, R, t);
+  b[0] += Vector3d(5, 5, 5);  // an outlier with no weight
+  std::vector<double> w(a.size(), 1.0);
+  w[0] = 0;
+  const auto f = calib::align(a, b, w);
+  EXPECT_LT((f.R - R).norm(), 1e-9);
+  EXPECT_LT((f.t - t).norm(), 1e-9);
+  EXPECT_GT(f.max, 8.0);  // the residual of the zero-weight point is still reported
+  // Umeyama: a uniform scale.
+  calib::AlignOptions o;
+  o.with_scale = true;
+  const auto s = calib::align(a, moved(a, R, t, 2.5), {}, o);
+  EXPECT_NEAR(s.scale, 2.5, 1e-9);
+  EXPECT_LT((s.R - R).norm(), 1e-9);
+  EXPECT_LT((s.t - t).norm(), 1e-9);
+}
+
+TEST(Rigid, RansacIgnoresOutliers) {
+  const Matrix3d R = rot(95, 0, 3);
+  const Vector3d t(2, 0, -1);
+  const auto a = cloud(200, 7);
+  auto b = moved(a, R, t);
+  std::mt19937_64 rng(8);
+  std::uniform_real_distribution<double> u(-3, 3);
+  for (std::size_t i = 0; i < 80; ++i) b[i] = Vector3d(u(rng), u(rng), u(rng));  // 40 % wrong pairs
+  EXPECT_GT(calib::align(a, b).rms, 0.5);  // plain SVD is pulled off
+  calib::RansacOptions o;
+  o.inlier_threshold_m = 0.02;
+  const auto r = calib::ransac_align(a, b, o);
+  EXPECT_LT((r.fit.R - R).norm(), 1e-9);
+  EXPECT_LT((r.fit.t - t).norm(), 1e-9);
+  EXPECT_GE(r.inliers.size(), 120u);
+  EXPECT_LE(r.inliers.size(), 122u);  // a random pair may land near its mate by chance
+  const auto again = calib::ransac_align(a, b, o);
+  EXPECT_EQ(again.inliers, r.inliers);  // deterministic with the seed
+  // Nothing consistent at all: a clear error.
+  EXPECT_NE(error_of([&] { calib::ransac_align(cloud(50, 9), cloud(50, 10), o); }).find("no consistent subset"),
+            std::string::npos);
+}
+
+namespace {
+
+struct SimPair {
+  std::vector<calib::TimedSkeleton> ref, other;
+  Eigen::Isometry3d truth;  // ref_from_other
+};
+
+SimPair simulate(const std::string& scenario, int people, double seconds, std::int64_t other_clock_shift_ns = 0) {
+  sim::SimConfig cfg;
+  cfg.scenario.name = scenario;
+  cfg.scenario.people = people;
+  cfg.scenario.repeats = 4;
+  sim::Simulation s(cfg);
+  SimPair p;
+  p.truth = cfg.sensors[0].world_from_sensor().inverse() * cfg.sensors[1].world_from_sensor();
+  for (auto& e : s.advance(seconds)) {
+    if (e.kind != sim::SimEvent::Kind::Raw) continue;
+    const auto t = static_cast<std::int64_t>(std::llround(e.t * 1e9));
+    if (e.sensor == 0) p.ref.push_back({t, e.skeleton});
+    if (e.sensor == 1) p.other.push_back({t + other_clock_shift_ns, e.skeleton});
+  }
+  return p;
+}
+
+void expect_pose(const calib::SkeletonCalibResult& r, const Eigen::Isometry3d& truth, double deg, double m) {
+  const double angle = calib::rotation_angle_deg(r.fit.R * truth.linear().transpose());
+  const double dist = (r.fit.t - truth.translation()).norm();
+  EXPECT_LT(angle, deg);
+  EXPECT_LT(dist, m);
+  std::printf("pose error %.3f deg, %.2f cm; %zu frames matched, %zu flipped, %zu/%zu pairs inliers, offset %.1f ms\n",
+              angle, dist * 100, r.matched, r.flipped, r.inliers, r.pairs, r.clock_offset_ns / 1e6);
+}
+
+}  // namespace
+
+TEST(SkeletonCalib, ThirtySecondsOfWalkingGiveThePose) {
+  const auto p = simulate("walk", 1, 30);
+  const auto r = calib::calibrate_from_skeletons(p.ref, p.other);
+  // The target is 0.5 deg / 1 cm; with the simulator's thesis-like
+  // tracker errors 30 s give about 0.5-0.8 deg and 1-3 cm (components/calib/README.md).
+  expect_pose(r, p.truth, 1.0, 0.03);
+  EXPECT_GT(r.inliers, 1000u);
+  ASSERT_EQ(r.per_joint.size(), 11u);
+  for (const auto& j : r.per_joint) EXPECT_GT(j.pairs, 0u) << skeleton::joint_name(j.joint);
+}
+
+TEST(SkeletonCalib, FlippedFramesAreRejected) {
+  // A third of the other sensor's frames with left and right swapped, as a
+  // tracker does when it sees the person's back.
+  auto p = simulate("walk", 1, 30);
+  std::size_t swapped = 0;
+  for (std::size_t i = 0; i < p.other.size(); ++i) {
+    if (i % 90 < 30) {
+      skeleton::swap_sides(p.other[i].skeleton);
+      ++swapped;
+    }
+  }
+  const auto r = calib::calibrate_from_skeletons(p.ref, p.other);
+  EXPECT_GT(r.flipped, swapped / 2);  // (frames next to a swapped one interpolate across it and drop out too)
+  expect_pose(r, p.truth, 1.0, 0.03);
+}
+
+TEST(SkeletonCalib, TwoPeopleAreToldApartWithoutIds) {
+  auto two = simulate("walk", 2, 30);
+  // Ids say nothing: the other sensor numbers its people the other way round.
+  for (auto& s : two.other) s.skeleton.person_id = 1000 - s.skeleton.person_id;
+  expect_pose(calib::calibrate_from_skeletons(two.ref, two.other), two.truth, 1.0, 0.03);
+}
+
+TEST(SkeletonCalib, FindsTheClockOffset) {
+  const auto p = simulate("walk", 1, 30, 120'000'000);  // the other sensor's clock runs 120 ms ahead
+  calib::SkeletonCalibOptions o;
+  o.max_clock_offset_ns = 300'000'000;
+  const auto r = calib::calibrate_from_skeletons(p.ref, p.other, o);
+  EXPECT_NEAR(r.clock_offset_ns / 1e6, -120.0, 6.0);
+  expect_pose(r, p.truth, 1.0, 0.03);
+}
+
+TEST(SkeletonCalib, HeldOutDistancesShrink) {
+  const auto p = simulate("walk", 1, 30);
+  const auto r = calib::calibrate_from_skeletons(p.ref, p.other);
+  const auto before = calib::median(calib::joint_distances(p.ref, p.other, Eigen::Isometry3d::Identity(), 0, {}, 10.0));
+  const auto after = calib::median(calib::joint_distances(p.ref, p.other, r.fit.transform()));
+  EXPECT_GT(before, 0.3);  // the sensors' frames are far apart
+  EXPECT_LT(after, 0.08);
+}
+
+TEST(SkeletonCalib, NothingToSolveIsAClearError) {
+  const auto p = simulate("walk", 1, 5);
+  std::vector<calib::TimedSkeleton> late = p.other;
+  for (auto& s : late) s.t_ns += 3'600'000'000'000;
+  EXPECT_NE(error_of([&] { calib::calibrate_from_skeletons(p.ref, late); }).find("within 70 ms"), std::string::npos);
+  EXPECT_NE(error_of([&] { calib::calibrate_from_skeletons(p.ref, {}); }).find("both sensors"), std::string::npos);
+}

@@ -1,0 +1,271 @@
+// skelgraph calib skeleton: sensor extrinsics from the skeletons two sensors
+// report of the same people (no board), with residuals, a held-out check and
+// a calibration file fusion can use. No DDS.
+
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+#include <nlohmann/json.hpp>
+
+#include "cli.hpp"
+#include "skelgraph/calib/calib_file.hpp"
+#include "skelgraph/calib/skeleton_calib.hpp"
+#include "skelgraph/mcap/mcap.hpp"
+#include "skelgraph/msg/cdr.hpp"
+#include "skelgraph/playback/readers.hpp"
+#include "skelgraph/runtime/topics.hpp"
+#include "skelgraph/skeleton/skeleton_msg.hpp"
+
+namespace skelgraph::cli {
+
+namespace {
+
+struct SkelOptions {
+  std::vector<std::string> inputs;
+  std::string format;  // empty: MCAP recordings
+  std::string ref, other, out, ref_pose;
+  double threshold_m = 0.12, clock_search_ms = 0;
+  bool holdout = false, json = false;
+};
+
+// Each sensor's skeletons of one input, on one clock (a recording's log
+// time; a data set's stamps), and the poses the input already has.
+struct Input {
+  std::map<std::string, std::vector<calib::TimedSkeleton>> by_sensor;
+  std::map<std::string, Eigen::Isometry3d> poses;  // world_from_sensor, if recorded
+};
+
+Input read_input(const std::string& path, const std::string& format) {
+  Input in;
+  if (!format.empty()) {
+    playback::Recording rec;
+    try {
+      rec = playback::read_recording(*playback::format_from_name(format), path);
+    } catch (const std::exception& e) {
+      throw UsageError(e.what());
+    }
+    for (const auto& s : rec.frames) in.by_sensor[s.sensor_id].push_back({s.stamp_ns, s});
+    return in;
+  }
+  try {
+    const mcap::Reader reader(path);
+    reader.for_each_message([&](const mcap::Channel& ch, const mcap::Schema* schema, const mcap::Message& m) {
+      if (schema == nullptr) return;
+      const auto* bytes = reinterpret_cast<const std::uint8_t*>(m.data.data());
+      if (ch.topic == runtime::topics::kSkeletonRaw.name && schema->name == msg::MessageTraits<msg::Skeleton>::name) {
+        auto s = skeleton::from_msg(msg::from_cdr<msg::Skeleton>(bytes, m.data.size()));
+        in.by_sensor[s.sensor_id].push_back({static_cast<std::int64_t>(m.log_time), std::move(s)});
+      } else if (ch.topic == runtime::topics::kCalibration.name &&
+                 schema->name == msg::MessageTraits<msg::SensorPose>::name) {
+        const auto p = skeleton::from_msg(msg::from_cdr<msg::SensorPose>(bytes, m.data.size()));
+        if (p.frame_id == "world") in.poses[p.sensor_id] = p.pose;
+      }
+    });
+  } catch (const mcap::McapError& e) {
+    throw UsageError(e.what());
+  }
+  return in;
+}
+
+nlohmann::json pose_json(const Eigen::Isometry3d& T) {
+  const Eigen::Quaterniond q(T.rotation());
+  return {{"translation_m", {T.translation().x(), T.translation().y(), T.translation().z()}},
+          {"rotation_xyzw", {q.x(), q.y(), q.z(), q.w()}},
+          {"rotation_deg", calib::rotation_angle_deg(T.rotation())}};
+}
+
+double cm(double m) { return std::isfinite(m) ? std::round(m * 1000.0) / 10.0 : m; }
+nlohmann::json num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
+
+// One input: fit (on the first half with --holdout), check, and the verdict.
+nlohmann::json calibrate_one(const std::string& path, const SkelOptions& o, skeleton::SensorPose* result) {
+  const Input in = read_input(path, o.format);
+  std::string names;
+  for (const auto& [id, v] : in.by_sensor) names += (names.empty() ? "" : ", ") + id + " (" + std::to_string(v.size()) + ")";
+  if (!in.by_sensor.count(o.ref)) throw UsageError(path + ": no skeletons of reference sensor '" + o.ref + "'; sensors: " + names);
+  std::string other = o.other;
+  if (other.empty()) {
+    for (const auto& [id, v] : in.by_sensor) {
+      if (id == o.ref) continue;
+      if (!other.empty()) throw UsageError(path + ": several other sensors (" + names + "): pick one with --other");
+      other = id;
+    }
+    if (other.empty()) throw UsageError(path + ": only the reference sensor has skeletons (" + names + ")");
+  } else if (!in.by_sensor.count(other)) {
+    throw UsageError(path + ": no skeletons of sensor '" + other + "'; sensors: " + names);
+  }
+  const auto& ref = in.by_sensor.at(o.ref);
+  const auto& oth = in.by_sensor.at(other);
+  // The pose the input already implies (a shared frame when it has none).
+  Eigen::Isometry3d before = Eigen::Isometry3d::Identity();
+  if (in.poses.count(o.ref) && in.poses.count(other)) before = in.poses.at(o.ref).inverse() * in.poses.at(other);
+
+  std::vector<calib::TimedSkeleton> fit_ref = ref, fit_oth = oth, test_ref, test_oth;
+  if (o.holdout) {
+    std::int64_t lo = ref.front().t_ns, hi = ref.front().t_ns;
+    for (const auto& s : ref) lo = std::min(lo, s.t_ns), hi = std::max(hi, s.t_ns);
+    const std::int64_t mid = lo + (hi - lo) / 2;
+    fit_ref.clear(), fit_oth.clear();
+    for (const auto& s : ref) (s.t_ns < mid ? fit_ref : test_ref).push_back(s);
+    for (const auto& s : oth) (s.t_ns < mid ? fit_oth : test_oth).push_back(s);
+  }
+  calib::SkeletonCalibOptions co;
+  co.inlier_threshold_m = o.threshold_m;
+  co.max_clock_offset_ns = static_cast<std::int64_t>(o.clock_search_ms * 1e6);
+  calib::SkeletonCalibResult r;
+  try {
+    r = calib::calibrate_from_skeletons(fit_ref, fit_oth, co);
+  } catch (const calib::CalibError& e) {
+    throw UsageError(path + ": cannot calibrate " + other + " against " + o.ref + ": " + e.what());
+  }
+  // Never worse than before: judged on the data it was fitted to (the held-out half stays unseen).
+  const double fit_before = calib::median(calib::joint_distances(fit_ref, fit_oth, before, 0, {}, 2.0));
+  const double fit_after = calib::median(calib::joint_distances(fit_ref, fit_oth, r.fit.transform(), r.clock_offset_ns, {}, 2.0));
+  const bool improved = !(fit_after >= fit_before);
+  const Eigen::Isometry3d chosen = improved ? r.fit.transform() : before;
+  const std::int64_t chosen_offset = improved ? r.clock_offset_ns : 0;
+
+  nlohmann::json j{{"input", path},
+                   {"reference", o.ref},
+                   {"other", other},
+                   {"frames", {{o.ref, ref.size()}, {other, oth.size()}}},
+                   {"reference_from_other", pose_json(r.fit.transform())},
+                   {"clock_offset_ms", r.clock_offset_ns / 1e6},
+                   {"matched_frames", r.matched},
+                   {"flipped_frames_rejected", r.flipped},
+                   {"joint_pairs", r.pairs},
+                   {"inliers", r.inliers},
+                   {"rms_residual_cm", cm(r.fit.rms)},
+                   {"max_residual_cm", cm(r.fit.max)},
+                   {"fit_median_distance_cm", {{"before", num(cm(fit_before))}, {"after", num(cm(fit_after))}}}};
+  nlohmann::json per = nlohmann::json::object();
+  for (const auto& jr : r.per_joint) {
+    per[skeleton::joint_name(jr.joint)] = {{"pairs", jr.pairs}, {"median_cm", num(cm(jr.median_m))}, {"rms_cm", num(cm(jr.rms_m))}};
+  }
+  j["per_joint"] = per;
+  if (o.holdout) {
+    const double b = calib::median(calib::joint_distances(test_ref, test_oth, before, 0, {}, 2.0));
+    const double a = calib::median(calib::joint_distances(test_ref, test_oth, chosen, chosen_offset, {}, 2.0));
+    j["held_out_median_distance_cm"] = {{"before", num(cm(b))}, {"after", num(cm(a))}};
+  }
+  j["verdict"] = improved ? "calibrated: the fitted pose brings the sensors' skeletons closer than before"
+                          : "kept the previous pose: the fit did not bring the skeletons closer on the data it saw";
+  j["improved"] = improved;
+  if (result != nullptr) {
+    result->sensor_id = other;
+    result->pose = chosen;
+    result->method = improved ? "skeleton" : "unchanged";
+    result->rms_residual_m = r.fit.rms;
+    result->max_residual_m = r.fit.max;
+  }
+  return j;
+}
+
+int calib_skeleton(const SkelOptions& o) {
+  if (!o.format.empty() && !playback::format_from_name(o.format)) throw UsageError("unknown format " + o.format);
+  if (!o.out.empty() && o.inputs.size() != 1) throw UsageError("--out needs exactly one input");
+  nlohmann::json all = nlohmann::json::array();
+  int failed = 0;
+  for (const auto& path : o.inputs) {
+    skeleton::SensorPose pose;
+    nlohmann::json j;
+    try {
+      j = calibrate_one(path, o, &pose);
+    } catch (const UsageError& e) {
+      // One bad input does not stop the others; the exit code says something failed.
+      if (o.inputs.size() == 1) throw;
+      std::fprintf(stderr, "%s\n", e.what());
+      all.push_back({{"input", path}, {"error", e.what()}});
+      ++failed;
+      continue;
+    }
+    if (!o.out.empty()) {
+      // world = the reference sensor's frame, unless --ref-pose places the reference in a world.
+      Eigen::Isometry3d world_from_ref = Eigen::Isometry3d::Identity();
+      if (!o.ref_pose.empty()) {
+        bool found = false;
+        try {
+          for (const auto& p : calib::read_calib_file(o.ref_pose).sensors) {
+            if (p.sensor_id == o.ref) world_from_ref = p.pose, found = true;
+          }
+        } catch (const calib::CalibFileError& e) {
+          throw UsageError(e.what());
+        }
+        if (!found) throw UsageError(o.ref_pose + ": has no pose of the reference sensor '" + o.ref + "'");
+      }
+      calib::CalibFile f;
+      f.comment = "written by skelgraph calib skeleton " + path + " --ref " + o.ref;
+      skeleton::SensorPose ref;
+      ref.sensor_id = o.ref;
+      ref.pose = world_from_ref;
+      ref.method = o.ref_pose.empty() ? "reference" : "from " + o.ref_pose;
+      pose.pose = world_from_ref * pose.pose;
+      f.sensors = {ref, pose};
+      try {
+        calib::write_calib_file(o.out, f);
+      } catch (const calib::CalibFileError& e) {
+        throw UsageError(e.what());
+      }
+      j["written"] = o.out;
+    }
+    if (!o.json) {
+      std::printf("%s: %s from %s\n", path.c_str(), j["other"].get<std::string>().c_str(), o.ref.c_str());
+      const auto& p = j["reference_from_other"];
+      std::printf("  pose: rotation %.2f deg, translation [%.3f, %.3f, %.3f] m, clock offset %.1f ms\n",
+                  p["rotation_deg"].get<double>(), p["translation_m"][0].get<double>(), p["translation_m"][1].get<double>(),
+                  p["translation_m"][2].get<double>(), j["clock_offset_ms"].get<double>());
+      std::printf("  %zu frames matched, %zu rejected as left/right flipped; %zu of %zu joint pairs within %.0f cm, "
+                  "RMS %.1f cm, max %.1f cm\n",
+                  j["matched_frames"].get<std::size_t>(), j["flipped_frames_rejected"].get<std::size_t>(),
+                  j["inliers"].get<std::size_t>(), j["joint_pairs"].get<std::size_t>(), o.threshold_m * 100,
+                  j["rms_residual_cm"].get<double>(), j["max_residual_cm"].get<double>());
+      std::printf("  per joint (median / RMS cm):");
+      for (const auto& [name, v] : j["per_joint"].items()) {
+        std::printf(" %s %s/%s", name.c_str(), v["median_cm"].dump().c_str(), v["rms_cm"].dump().c_str());
+      }
+      std::printf("\n  median joint distance between the sensors, fitted data: %s -> %s cm\n",
+                  j["fit_median_distance_cm"]["before"].dump().c_str(), j["fit_median_distance_cm"]["after"].dump().c_str());
+      if (o.holdout) {
+        std::printf("  held-out second half: %s -> %s cm\n", j["held_out_median_distance_cm"]["before"].dump().c_str(),
+                    j["held_out_median_distance_cm"]["after"].dump().c_str());
+      }
+      std::printf("  %s%s\n", j["verdict"].get<std::string>().c_str(),
+                  o.out.empty() ? "" : ("; written to " + o.out).c_str());
+    }
+    all.push_back(std::move(j));
+  }
+  if (o.json) std::printf("%s\n", all.dump(2).c_str());
+  return failed > 0 ? 1 : 0;
+}
+
+}  // namespace
+
+void add_calib_command(CLI::App& app, GlobalOptions&, Action& run) {
+  auto* cal = app.add_subcommand("calib", "Sensor calibration");
+  cal->require_subcommand(1);
+  auto o = std::make_shared<SkelOptions>();
+  auto* s = cal->add_subcommand(
+      "skeleton",
+      "Extrinsics from the person's own skeleton: two sensors' skeletons of the same people at the same time "
+      "(walk around in front of both for 30 s); flipped frames and other people are rejected");
+  s->add_option("inputs", o->inputs, "MCAP recordings (skelgraph/skeleton/raw), or data-set files with --format")
+      ->required()
+      ->check(CLI::ExistingFile);
+  s->add_option("--format", o->format, "the inputs are data-set files of this format")
+      ->check(CLI::IsMember(playback::format_names()));
+  s->add_option("--ref", o->ref, "reference sensor id (its frame is the result's frame)")->required();
+  s->add_option("--other", o->other, "the sensor to calibrate (default: the only other one)");
+  s->add_option("--threshold-m", o->threshold_m, "a joint pair agrees within this under a good pose")->check(kPositive);
+  s->add_option("--clock-search-ms", o->clock_search_ms,
+                "search the other sensor's clock offset within +-this (0: the clocks agree)")
+      ->check(kNonNegative);
+  s->add_flag("--holdout", o->holdout, "fit on the first half of each input, report distances on the second half");
+  s->add_option("--out", o->out, "write a calibration file (YAML; e.g. bringup/calib/NAME.yaml)");
+  s->add_option("--ref-pose", o->ref_pose, "a calibration file with the reference sensor's pose in the world (default: the reference is the world)")
+      ->check(CLI::ExistingFile);
+  s->add_flag("--json", o->json, "machine-readable results, one object per input");
+  s->callback([o, &run] { run = [o] { return calib_skeleton(*o); }; });
+}
+
+}  // namespace skelgraph::cli
