@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli.hpp"
+#include "skelgraph/calib/calib_file.hpp"
 #include "skelgraph/playback/readers.hpp"
 #include "skelgraph/sim/realism.hpp"
 #include "skelgraph/sim/sim_component.hpp"
@@ -83,20 +84,47 @@ void write_file(const std::filesystem::path& path, const playback::Recording& re
 }
 
 // Runs the simulation offline and writes truth.csv, raw_<sensor>.csv and phases.csv.
-int export_run(const std::vector<std::string>& assignments, const std::string& dir, bool json) {
+// The simulator's configuration from -p KEY=VALUE, checked (UsageError).
+sim::SimConfig config_from(const std::vector<std::string>& assignments, const char* what) {
   runtime::ParamSchema schema;
   sim::add_sim_params(schema);
-  sim::SimConfig cfg;
   try {
     std::vector<runtime::RawParam> raw;
     for (const auto& p : assignments) raw.push_back(runtime::parse_param_assignment(p, "--param " + p));
-    cfg = sim::sim_config_from(schema.resolve(raw, "sim export"));
+    auto cfg = sim::sim_config_from(schema.resolve(raw, what));
     sim::Simulation probe(cfg);  // checks the configuration
+    return cfg;
   } catch (const runtime::ParamError& e) {
     throw UsageError(e.what());
   } catch (const std::invalid_argument& e) {
     throw UsageError(e.what());
   }
+}
+
+// The simulated sensors' true poses as a calibration file.
+int write_poses(const std::vector<std::string>& assignments, const std::string& out, bool json) {
+  const auto cfg = config_from(assignments, "sim poses");
+  calib::CalibFile f;
+  f.comment = "the simulator's true sensor poses (skelgraph sim poses)";
+  for (const auto& s : cfg.sensors) {
+    skeleton::SensorPose p;
+    p.sensor_id = s.id;
+    p.pose = s.world_from_sensor();
+    p.method = "ground_truth";
+    f.sensors.push_back(p);
+  }
+  try {
+    calib::write_calib_file(out, f);
+  } catch (const calib::CalibFileError& e) {
+    throw UsageError(e.what());
+  }
+  if (json) std::printf("%s\n", nlohmann::json{{"out", out}, {"sensors", f.sensors.size()}}.dump(2).c_str());
+  else std::printf("%s: %zu sensor pose(s)\n", out.c_str(), f.sensors.size());
+  return 0;
+}
+
+int export_run(const std::vector<std::string>& assignments, const std::string& dir, bool json) {
+  const auto cfg = config_from(assignments, "sim export");
   sim::Simulation sim(cfg);
   std::map<std::string, std::string> meta{{"source", "skelgraph sim"},
                                           {"scenario", cfg.scenario.name},
@@ -186,6 +214,13 @@ void add_sim_command(CLI::App& app, GlobalOptions&, Action& run) {
   x->add_option("-p,--param", e->params, "sim parameter as KEY=VALUE, as in `skelgraph components` (repeatable)");
   x->add_flag("--json", e->json, "machine-readable summary");
   x->callback([e, &run] { run = [e] { return export_run(e->params, e->dir, e->json); }; });
+
+  auto po = std::make_shared<ExportOpts>();
+  auto* ps = cmd->add_subcommand("poses", "Write the simulated sensors' true poses as a calibration file (YAML)");
+  ps->add_option("file", po->dir, "calibration file to write")->required();
+  ps->add_option("-p,--param", po->params, "sim parameter as KEY=VALUE (sensor_count, sensors)");
+  ps->add_flag("--json", po->json, "machine-readable summary");
+  ps->callback([po, &run] { run = [po] { return write_poses(po->params, po->dir, po->json); }; });
 }
 
 }  // namespace skelgraph::cli

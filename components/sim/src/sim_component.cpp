@@ -63,6 +63,7 @@ runtime::ComponentInfo SimComponent::describe() {
       .add_string_list("publish_sensors", {}, "publish only these sensors' skeletons and poses (default: all); "
                                               "with wall_clock_aligned, several sims can each play some sensors of one cell")
       .add_bool("publish_truth", true, "publish ground truth")
+      .add_bool("publish_poses", true, "publish the sensors' true poses (off: a calibration file or component provides them)")
       .add_bool("wall_clock_aligned", false,
                 "scenario time = wall clock modulo the scenario's duration, so sims started at different times (or "
                 "restarted) agree on where the person is; implies loop");
@@ -86,6 +87,7 @@ SimComponent::SimComponent(runtime::Context& ctx, const runtime::Params& params)
     }
   }
   publish_truth_ = params.get<bool>("publish_truth");
+  publish_poses_ = params.get<bool>("publish_poses");
   aligned_ = params.get<bool>("wall_clock_aligned");
 }
 
@@ -95,6 +97,7 @@ bool SimComponent::publishes(std::size_t sensor) const {
 }
 
 void SimComponent::publish_poses() {
+  if (!publish_poses_) return;
   for (std::size_t i = 0; i < config_.sensors.size(); ++i) {
     if (!publishes(i)) continue;
     const auto& s = config_.sensors[i];

@@ -39,7 +39,7 @@ class SimComponent final : public runtime::Component {
   runtime::TimerHandle timer_;
   std::int64_t start_mono_ns_ = 0;
   std::vector<std::string> publish_sensors_;  // empty: all
-  bool publish_truth_ = true, aligned_ = false;
+  bool publish_truth_ = true, publish_poses_ = true, aligned_ = false;
   double skip_before_s_ = 0.0;  // aligned start: events before this were "published" before we started
   bool publishes(std::size_t sensor) const;
   double loop_offset_s_ = 0.0;  // world time at which the current run started
