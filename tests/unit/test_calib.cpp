@@ -248,3 +248,98 @@ TEST(SkeletonCalib, NothingToSolveIsAClearError) {
   EXPECT_NE(error_of([&] { calib::calibrate_from_skeletons(p.ref, late); }).find("within 70 ms"), std::string::npos);
   EXPECT_NE(error_of([&] { calib::calibrate_from_skeletons(p.ref, {}); }).find("both sensors"), std::string::npos);
 }
+
+// --- Checkerboards (synthetic views rendered with known intrinsics and poses) ---
+
+#include "skelgraph/calib/board.hpp"
+
+namespace {
+
+struct BoardScene {
+  calib::Board board;
+  calib::Intrinsics k;
+  std::vector<Eigen::Isometry3d> sensors;  // world_from_sensor
+  std::vector<Eigen::Isometry3d> boards;   // world_from_board
+};
+
+BoardScene board_scene(int views) {
+  BoardScene s;
+  sim::SimConfig cfg;
+  for (const auto& c : cfg.sensors) s.sensors.push_back(c.world_from_sensor());
+  s.boards = calib::board_poses_seen_by(s.sensors, s.board, s.k, views, Vector3d(0, 1.2, 0), 11);
+  return s;
+}
+
+}  // namespace
+
+TEST(Board, CornersAreFoundWhereTheyProject) {
+  const auto s = board_scene(5);
+  double worst = 0;
+  for (std::size_t v = 0; v < s.boards.size(); ++v) {
+    const auto cb = calib::camera_from_board(s.sensors[v % 2], s.boards[v]);
+    const auto view = calib::render_board_view(s.board, s.k, cb, 2.0, 1.0, v);
+    const auto corners = calib::find_corners(view.grey, s.board);
+    ASSERT_TRUE(corners) << "view " << v;
+    const auto obj = s.board.object_points();
+    for (std::size_t i = 0; i < obj.size(); ++i) {
+      const Vector3d q = cb * obj[i];
+      const double u = s.k.fx * q.x() / q.z() + s.k.cx, w = s.k.fy * q.y() / q.z() + s.k.cy;
+      worst = std::max(worst, std::hypot((*corners)[i].x - u, (*corners)[i].y - w));
+    }
+  }
+  EXPECT_LT(worst, 0.5);  // pixels, in the board's own order (not turned by 180 degrees)
+  // No board, no corners.
+  EXPECT_FALSE(calib::find_corners(cv::Mat(480, 640, CV_8U, cv::Scalar(128)), s.board));
+}
+
+TEST(Board, IntrinsicsFromViews) {
+  auto s = board_scene(1);
+  // Views for one sensor only: the board turned towards it, tilted every way.
+  s.boards = calib::board_poses_seen_by({s.sensors[0]}, s.board, s.k, 15, Vector3d(0, 1.2, 0.6), 12);
+  std::vector<std::vector<cv::Point2f>> all;
+  for (std::size_t v = 0; v < s.boards.size(); ++v) {
+    const auto view = calib::render_board_view(s.board, s.k, calib::camera_from_board(s.sensors[0], s.boards[v]), 2.0, 1.0, v);
+    if (auto c = calib::find_corners(view.grey, s.board)) all.push_back(*c);
+  }
+  ASSERT_GE(all.size(), 12u);
+  const auto r = calib::calibrate_intrinsics(all, s.board, cv::Size(640, 480));
+  EXPECT_NEAR(r.intrinsics.fx, 525, 525 * 0.01);
+  EXPECT_NEAR(r.intrinsics.fy, 525, 525 * 0.01);
+  EXPECT_NEAR(r.intrinsics.cx, 319.5, 4);
+  EXPECT_NEAR(r.intrinsics.cy, 239.5, 4);
+  EXPECT_LT(r.rms_reprojection_px, 0.5);
+  EXPECT_THROW(calib::calibrate_intrinsics({all[0], all[1]}, s.board, cv::Size(640, 480)), CalibError);
+}
+
+TEST(Board, TwentyViewsGiveTheExtrinsics) {
+  const auto s = board_scene(20);
+  std::vector<std::vector<Vector3d>> ref, other;
+  double worst_lift = 0;
+  for (std::size_t v = 0; v < s.boards.size(); ++v) {
+    std::vector<Vector3d> lifted[2];
+    for (int c = 0; c < 2; ++c) {
+      const auto cb = calib::camera_from_board(s.sensors[c], s.boards[v]);
+      const auto view = calib::render_board_view(s.board, s.k, cb, 2.0, 1.0, 100 * v + c);
+      const auto corners = calib::find_corners(view.grey, s.board);
+      ASSERT_TRUE(corners);
+      lifted[c] = calib::lift_corners(*corners, view.depth_mm, s.k, s.board).points;
+      const auto obj = s.board.object_points();
+      for (std::size_t i = 0; i < obj.size(); ++i) worst_lift = std::max(worst_lift, (lifted[c][i] - cb * obj[i]).norm());
+    }
+    ref.push_back(lifted[0]);
+    other.push_back(lifted[1]);
+  }
+  EXPECT_LT(worst_lift, 0.02);  // every corner within 2 cm in 3-D
+  const auto r = calib::pose_from_views(ref, other);
+  // camera frames -> skelgraph sensor frames
+  const Eigen::Matrix3d S = calib::sensor_from_camera();
+  const Eigen::Matrix3d R = S * r.fit.R * S.transpose();
+  const Vector3d t = S * r.fit.t;
+  const Eigen::Isometry3d truth = s.sensors[0].inverse() * s.sensors[1];
+  const double angle = calib::rotation_angle_deg(R * truth.linear().transpose());
+  const double dist = (t - truth.translation()).norm();
+  std::printf("board: 20 views, pose error %.3f deg, %.2f cm, %zu/%zu corners inliers, RMS %.2f cm\n", angle, dist * 100,
+              r.inliers.size(), ref.size() * ref[0].size(), r.fit.rms * 100);
+  EXPECT_LT(angle, 0.5);
+  EXPECT_LT(dist, 0.01);
+}
