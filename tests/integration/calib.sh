@@ -12,7 +12,9 @@ S=$SKELGRAPH
 "$S" calib skeleton "$WORK/walk.mcap" --ref sensor1 --ref-pose "$WORK/truth.yaml" --clock-search-ms 100 \
   --out "$WORK/calib.yaml" --json >"$WORK/calib.json" 2>"$WORK/calib.err" || fail "calib skeleton: $(cat "$WORK/calib.err")"
 json_check "$WORK/calib.json" 'd[0]["improved"] and len(d[0]["per_joint"]) == 11 and d[0]["inliers"] > 1000'
-python3 - "$WORK/truth.yaml" "$WORK/calib.yaml" <<'PY' || fail "calibrated pose against the truth"
+# compare_pose TRUTH CALIB MAX_M MAX_DEG: sensor2's pose in CALIB against TRUTH.
+compare_pose() {
+python3 - "$@" <<'PY'
 import math, re, sys
 def poses(path):
     out, cur = {}, None
@@ -27,12 +29,29 @@ dist = math.dist(t["translation"], c["translation"])
 dot = abs(sum(a * b for a, b in zip(t["rotation_xyzw"], c["rotation_xyzw"])))
 angle = math.degrees(2 * math.acos(min(1.0, dot)))
 print("sensor2 against the truth: %.2f cm, %.2f deg" % (dist * 100, angle))
-assert dist < 0.03 and angle < 1.0, (dist, angle)
+assert dist < float(sys.argv[3]) and angle < float(sys.argv[4]), (dist, angle)
 PY
+}
+compare_pose "$WORK/truth.yaml" "$WORK/calib.yaml" 0.03 1.0 || fail "skeleton calibration against the truth"
 ok "skeleton calibration: sensor2 within 3 cm and 1 degree of the truth"
 
-# Bad input: a sensor that is not there, a malformed calibration file.
+# Checkerboard: intrinsics of each sensor from its own views, then the
+# extrinsics from 20 views both see (colour + depth), against the truth.
+"$S" sim boards "$WORK/boards" --views 20 >/dev/null 2>&1 || fail "sim boards"
+for s in sensor1 sensor2; do
+  "$S" calib intrinsics "$WORK/boards/$s"/intrinsics/*_color.png --out "$WORK/boards/$s/intrinsics.yaml" --json \
+    >"$WORK/intr_$s.json" 2>"$WORK/intr.err" || fail "calib intrinsics $s: $(cat "$WORK/intr.err")"
+  json_check "$WORK/intr_$s.json" 'abs(d["fx"] - 525) < 5 and abs(d["fy"] - 525) < 5 and abs(d["cx"] - 319.5) < 4 and abs(d["cy"] - 239.5) < 4 and d["rms_reprojection_px"] < 0.5'
+done
+"$S" calib board "$WORK/boards/sensor1" "$WORK/boards/sensor2" --ref-pose "$WORK/boards/truth.yaml" \
+  --out "$WORK/board_calib.yaml" --json >"$WORK/board.json" 2>"$WORK/board.err" || fail "calib board: $(cat "$WORK/board.err")"
+json_check "$WORK/board.json" 'd["views_used"] == 20 and d["rms_residual_cm"] < 1'
+compare_pose "$WORK/boards/truth.yaml" "$WORK/board_calib.yaml" 0.01 0.5 || fail "board calibration against the truth"
+ok "checkerboard: intrinsics within 1 %, sensor2 within 1 cm and 0.5 degree of the truth from 20 views"
+
+# Bad input: a sensor that is not there, a malformed calibration file, missing intrinsics.
 set +e
+"$S" calib board "$WORK/boards/sensor1" "$WORK/exp" >/dev/null 2>"$WORK/bad3.err"; rc3=$?
 "$S" calib skeleton "$WORK/walk.mcap" --ref nosuch >/dev/null 2>"$WORK/bad1.err"; rc1=$?
 printf 'version: 1\nsensors:\n  - id: s1\n    translation: [0, 1]\n    rotation_xyzw: [0, 0, 0, 1]\n' >"$WORK/bad.yaml"
 printf 'components:\n  - name: calibration\n    type: calibration\n    params: {file: %s}\n' "$WORK/bad.yaml" >"$WORK/bad_launch.yaml"
@@ -42,7 +61,9 @@ set -e
   fail "unknown sensor: rc $rc1, $(cat "$WORK/bad1.err")"
 [ "$rc2" -ne 0 ] && grep -q "bad.yaml:4:.*'translation' expects a list of 3 numbers" "$WORK/bad2.err" ||
   fail "malformed calibration file: rc $rc2, $(cat "$WORK/bad2.err")"
-ok "bad input: clear errors (unknown sensor; file:line of a malformed calibration file)"
+[ "$rc3" -eq 2 ] && grep -q "exp/intrinsics.yaml: no intrinsics (run \`skelgraph calib intrinsics" "$WORK/bad3.err" ||
+  fail "missing intrinsics: rc $rc3, $(cat "$WORK/bad3.err")"
+ok "bad input: clear errors (unknown sensor; file:line of a malformed calibration file; missing intrinsics)"
 
 # The launch file: poses only from bringup/calib/sim_dual.yaml; the fused
 # skeleton (recorded live) is scored against the truth in the world frame.

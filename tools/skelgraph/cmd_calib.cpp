@@ -1,14 +1,20 @@
-// skelgraph calib skeleton: sensor extrinsics from the skeletons two sensors
-// report of the same people (no board), with residuals, a held-out check and
-// a calibration file fusion can use. No DDS.
+// skelgraph calib skeleton|intrinsics|board: sensor extrinsics from the
+// skeletons two sensors report of the same people (no board), camera
+// intrinsics from checkerboard images, and extrinsics from a checkerboard both
+// sensors see (colour + depth); each with residuals, a verdict and a file
+// (YAML) fusion can use. No DDS.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <map>
 
 #include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "cli.hpp"
+#include "skelgraph/calib/board.hpp"
 #include "skelgraph/calib/calib_file.hpp"
 #include "skelgraph/calib/skeleton_calib.hpp"
 #include "skelgraph/mcap/mcap.hpp"
@@ -239,6 +245,216 @@ int calib_skeleton(const SkelOptions& o) {
   return failed > 0 ? 1 : 0;
 }
 
+// --- Checkerboards ---
+
+struct BoardOptions {
+  std::vector<std::string> images;  // intrinsics
+  std::string ref_dir, other_dir, ref = "sensor1", other = "sensor2";
+  std::string size = "9x6";
+  double square_m = 0.08;
+  std::string ref_intrinsics, other_intrinsics, ref_pose, out;
+  bool json = false;
+};
+
+cv::Mat read_image(const std::string& path, int flags) {
+  cv::Mat m = cv::imread(path, flags);
+  if (m.empty()) throw UsageError(path + ": cannot read the image (missing, or not an image OpenCV reads)");
+  return m;
+}
+
+calib::Board board_of(const BoardOptions& o) {
+  try {
+    return calib::Board::parse(o.size, o.square_m);
+  } catch (const calib::CalibError& e) {
+    throw UsageError(e.what());
+  }
+}
+
+int calib_intrinsics(const BoardOptions& o) {
+  const auto board = board_of(o);
+  std::vector<std::vector<cv::Point2f>> found;
+  std::vector<std::string> missed;
+  cv::Size size;
+  for (std::size_t i = 0; i < o.images.size(); ++i) {
+    const cv::Mat grey = read_image(o.images[i], cv::IMREAD_GRAYSCALE);
+    if (size.area() == 0) size = grey.size();
+    if (grey.size() != size) throw UsageError(o.images[i] + ": " + std::to_string(grey.cols) + "x" + std::to_string(grey.rows) +
+                                              ", the other images are " + std::to_string(size.width) + "x" + std::to_string(size.height));
+    if (auto c = calib::find_corners(grey, board)) found.push_back(std::move(*c));
+    else missed.push_back(o.images[i]);
+    if (!o.json) std::fprintf(stderr, "\rlooking for the board: %zu of %zu images", i + 1, o.images.size());
+  }
+  if (!o.json) std::fprintf(stderr, "\n");
+  calib::IntrinsicsResult r;
+  try {
+    r = calib::calibrate_intrinsics(found, board, size);
+  } catch (const calib::CalibError& e) {
+    throw UsageError(e.what());
+  }
+  const auto& k = r.intrinsics;
+  const bool good = r.rms_reprojection_px < 1.0;
+  nlohmann::json j{{"images", o.images.size()}, {"views_used", r.views}, {"board_not_found", missed},
+                   {"width", k.width}, {"height", k.height}, {"fx", k.fx}, {"fy", k.fy}, {"cx", k.cx}, {"cy", k.cy},
+                   {"distortion", k.distortion}, {"rms_reprojection_px", r.rms_reprojection_px},
+                   {"verdict", good ? "good: reprojection RMS below 1 px" : "poor: reprojection RMS of 1 px or more (blurred images, a bent board, the wrong --board?)"}};
+  if (!o.out.empty()) {
+    try {
+      calib::write_intrinsics_file(o.out, k, r.rms_reprojection_px, r.views,
+                                   "written by skelgraph calib intrinsics (" + std::to_string(r.views) + " views, board " + o.size + ")");
+    } catch (const calib::CalibFileError& e) {
+      throw UsageError(e.what());
+    }
+    j["written"] = o.out;
+  }
+  if (o.json) {
+    std::printf("%s\n", j.dump(2).c_str());
+  } else {
+    std::printf("board found in %zu of %zu images\nfx %.2f fy %.2f cx %.2f cy %.2f (%dx%d), reprojection RMS %.3f px: %s%s\n",
+                r.views, o.images.size(), k.fx, k.fy, k.cx, k.cy, k.width, k.height, r.rms_reprojection_px,
+                j["verdict"].get<std::string>().c_str(), o.out.empty() ? "" : ("; written to " + o.out).c_str());
+  }
+  return good ? 0 : 1;
+}
+
+// Views in DIR: NAME_color.png with NAME_depth.png (16-bit mm, registered to the colour image).
+std::vector<std::string> view_names(const std::string& dir) {
+  std::vector<std::string> names;
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
+    const auto f = e.path().filename().string();
+    const std::string tail = "_color.png";
+    if (f.size() > tail.size() && f.compare(f.size() - tail.size(), tail.size(), tail) == 0) {
+      names.push_back(f.substr(0, f.size() - tail.size()));
+    }
+  }
+  if (ec) throw UsageError(dir + ": " + ec.message());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+calib::Intrinsics intrinsics_for(const std::string& dir, const std::string& given) {
+  const std::string path = given.empty() ? (std::filesystem::path(dir) / "intrinsics.yaml").string() : given;
+  if (!std::filesystem::exists(path)) {
+    throw UsageError(path + ": no intrinsics (run `skelgraph calib intrinsics " + dir + "/*_color.png --out " + path +
+                     "`, or give them with --ref-intrinsics/--other-intrinsics)");
+  }
+  try {
+    return calib::read_intrinsics_file(path);
+  } catch (const calib::CalibFileError& e) {
+    throw UsageError(e.what());
+  }
+}
+
+int calib_board(const BoardOptions& o) {
+  const auto board = board_of(o);
+  const auto kr = intrinsics_for(o.ref_dir, o.ref_intrinsics);
+  const auto ko = intrinsics_for(o.other_dir, o.other_intrinsics);
+  std::vector<std::vector<Eigen::Vector3d>> ref, other;
+  std::vector<std::string> used, skipped;
+  const auto names = view_names(o.ref_dir);
+  if (names.empty()) throw UsageError(o.ref_dir + ": no NAME_color.png views");
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const auto& n = names[i];
+    std::vector<Eigen::Vector3d> lifted[2];
+    bool ok = true;
+    for (int c = 0; c < 2 && ok; ++c) {
+      const std::filesystem::path dir = c == 0 ? o.ref_dir : o.other_dir;
+      const auto colour = (dir / (n + "_color.png")).string(), depth = (dir / (n + "_depth.png")).string();
+      if (!std::filesystem::exists(colour) || !std::filesystem::exists(depth)) {
+        ok = false;
+        skipped.push_back(n + ": not in both directories with colour and depth");
+        break;
+      }
+      const auto corners = calib::find_corners(read_image(colour, cv::IMREAD_GRAYSCALE), board);
+      if (!corners) {
+        ok = false;
+        skipped.push_back(n + ": board not found in " + colour);
+        break;
+      }
+      const cv::Mat d = read_image(depth, cv::IMREAD_ANYDEPTH);
+      if (d.type() != CV_16U) throw UsageError(depth + ": expected a 16-bit depth image (millimetres)");
+      try {
+        lifted[c] = calib::lift_corners(*corners, d, c == 0 ? kr : ko, board).points;
+      } catch (const calib::CalibError& e) {
+        ok = false;
+        skipped.push_back(n + ": " + e.what());
+      }
+    }
+    if (!o.json) std::fprintf(stderr, "\rviews: %zu of %zu read", i + 1, names.size());
+    if (!ok) continue;
+    ref.push_back(std::move(lifted[0]));
+    other.push_back(std::move(lifted[1]));
+    used.push_back(n);
+  }
+  if (!o.json) std::fprintf(stderr, "\n");
+  if (ref.size() < 3) throw UsageError("the board was usable in only " + std::to_string(ref.size()) + " views (need 3): " + (skipped.empty() ? "" : skipped.front()));
+  calib::RansacResult r;
+  try {
+    r = calib::pose_from_views(ref, other);
+  } catch (const calib::CalibError& e) {
+    throw UsageError(e.what());
+  }
+  // Camera frames (x right, y down) -> skelgraph sensor frames (x left, y up).
+  const Eigen::Matrix3d S = calib::sensor_from_camera();
+  Eigen::Isometry3d ref_from_other = Eigen::Isometry3d::Identity();
+  ref_from_other.linear() = S * r.fit.R * S.transpose();
+  ref_from_other.translation() = S * r.fit.t;
+  const std::size_t corners = ref.size() * ref.front().size();
+  const bool good = r.fit.rms < 0.01 && r.inliers.size() * 10 >= corners * 9;
+  nlohmann::json j{{"reference", o.ref}, {"other", o.other}, {"views", names.size()}, {"views_used", used.size()},
+                   {"skipped", skipped}, {"reference_from_other", pose_json(ref_from_other)},
+                   {"corners", corners}, {"inliers", r.inliers.size()},
+                   {"rms_residual_cm", cm(r.fit.rms)}, {"max_residual_cm", cm(r.fit.max)},
+                   {"verdict", good ? "good: corners agree within 1 cm RMS" : "poor: corners disagree (RMS 1 cm or more, or over 10 % outliers): check the intrinsics and that the depth is registered"}};
+  if (!o.out.empty()) {
+    Eigen::Isometry3d world_from_ref = Eigen::Isometry3d::Identity();
+    std::string ref_method = "reference";
+    if (!o.ref_pose.empty()) {
+      bool found = false;
+      try {
+        for (const auto& p : calib::read_calib_file(o.ref_pose).sensors) {
+          if (p.sensor_id == o.ref) world_from_ref = p.pose, found = true;
+        }
+      } catch (const calib::CalibFileError& e) {
+        throw UsageError(e.what());
+      }
+      if (!found) throw UsageError(o.ref_pose + ": has no pose of the reference sensor '" + o.ref + "'");
+      ref_method = "from " + o.ref_pose;
+    }
+    calib::CalibFile f;
+    f.comment = "written by skelgraph calib board " + o.ref_dir + " " + o.other_dir;
+    skeleton::SensorPose pr, po;
+    pr.sensor_id = o.ref;
+    pr.pose = world_from_ref;
+    pr.method = ref_method;
+    po.sensor_id = o.other;
+    po.pose = world_from_ref * ref_from_other;
+    po.method = "checkerboard";
+    po.rms_residual_m = r.fit.rms;
+    po.max_residual_m = r.fit.max;
+    f.sensors = {pr, po};
+    try {
+      calib::write_calib_file(o.out, f);
+    } catch (const calib::CalibFileError& e) {
+      throw UsageError(e.what());
+    }
+    j["written"] = o.out;
+  }
+  if (o.json) {
+    std::printf("%s\n", j.dump(2).c_str());
+  } else {
+    const auto& p = j["reference_from_other"];
+    std::printf("%s from %s: %zu of %zu views used; rotation %.2f deg, translation [%.3f, %.3f, %.3f] m\n"
+                "%zu of %zu corners within 2 cm, RMS %.2f cm, max %.2f cm: %s%s\n",
+                o.other.c_str(), o.ref.c_str(), used.size(), names.size(), p["rotation_deg"].get<double>(),
+                p["translation_m"][0].get<double>(), p["translation_m"][1].get<double>(), p["translation_m"][2].get<double>(),
+                r.inliers.size(), corners, cm(r.fit.rms), cm(r.fit.max), j["verdict"].get<std::string>().c_str(),
+                o.out.empty() ? "" : ("; written to " + o.out).c_str());
+    for (const auto& s : skipped) std::printf("  skipped %s\n", s.c_str());
+  }
+  return good ? 0 : 1;
+}
+
 }  // namespace
 
 void add_calib_command(CLI::App& app, GlobalOptions&, Action& run) {
@@ -266,6 +482,37 @@ void add_calib_command(CLI::App& app, GlobalOptions&, Action& run) {
       ->check(CLI::ExistingFile);
   s->add_flag("--json", o->json, "machine-readable results, one object per input");
   s->callback([o, &run] { run = [o] { return calib_skeleton(*o); }; });
+
+  auto b = std::make_shared<BoardOptions>();
+  auto* in = cal->add_subcommand("intrinsics", "Camera intrinsics from images of a checkerboard (OpenCV calibrateCamera)");
+  in->add_option("images", b->images, "images of the board, 15 or more, tilted every way")->required()->check(CLI::ExistingFile);
+  in->add_option("--board", b->size, "inner corners COLSxROWS (default 9x6)");
+  in->add_option("--square", b->square_m, "square size, m (default 0.08)")->check(kPositive);
+  in->add_option("--out", b->out, "write an intrinsics file (YAML), e.g. DIR/intrinsics.yaml for calib board");
+  in->add_flag("--json", b->json, "machine-readable result");
+  in->callback([b, &run] { run = [b] { return calib_intrinsics(*b); }; });
+
+  auto* bo = cal->add_subcommand(
+      "board",
+      "Extrinsics between two sensors from a checkerboard both see: corners found in each colour image, lifted to 3-D "
+      "with the depth image, all views aligned by SVD");
+  bo->add_option("ref_dir", b->ref_dir, "reference sensor's views: NAME_color.png + NAME_depth.png (16-bit mm)")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  bo->add_option("other_dir", b->other_dir, "the other sensor's views, same NAMEs taken at the same moments")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  bo->add_option("--ref", b->ref, "reference sensor id (default sensor1)");
+  bo->add_option("--other", b->other, "other sensor id (default sensor2)");
+  bo->add_option("--board", b->size, "inner corners COLSxROWS (default 9x6)");
+  bo->add_option("--square", b->square_m, "square size, m (default 0.08)")->check(kPositive);
+  bo->add_option("--ref-intrinsics", b->ref_intrinsics, "intrinsics file (default: REF_DIR/intrinsics.yaml)");
+  bo->add_option("--other-intrinsics", b->other_intrinsics, "intrinsics file (default: OTHER_DIR/intrinsics.yaml)");
+  bo->add_option("--ref-pose", b->ref_pose, "a calibration file with the reference sensor's pose in the world")
+      ->check(CLI::ExistingFile);
+  bo->add_option("--out", b->out, "write a calibration file (YAML)");
+  bo->add_flag("--json", b->json, "machine-readable result");
+  bo->callback([b, &run] { run = [b] { return calib_board(*b); }; });
 }
 
 }  // namespace skelgraph::cli

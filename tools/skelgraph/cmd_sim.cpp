@@ -11,6 +11,9 @@
 #include <nlohmann/json.hpp>
 
 #include "cli.hpp"
+#include <opencv2/imgcodecs.hpp>
+
+#include "skelgraph/calib/board.hpp"
 #include "skelgraph/calib/calib_file.hpp"
 #include "skelgraph/playback/readers.hpp"
 #include "skelgraph/sim/realism.hpp"
@@ -123,6 +126,79 @@ int write_poses(const std::vector<std::string>& assignments, const std::string& 
   return 0;
 }
 
+// Synthetic checkerboard views of the simulated cell, to calibrate from:
+// DIR/<sensor>/NNN_color.png + NNN_depth.png (the board where every sensor
+// sees it, the same NNN at the same moment), DIR/<sensor>/intrinsics/ (views
+// for that sensor's intrinsics), and the truth: DIR/truth.yaml (poses) and
+// DIR/<sensor>/intrinsics_truth.yaml.
+struct BoardsOpts {
+  std::string dir, size = "9x6";
+  std::vector<std::string> params;
+  double square_m = 0.08, grey_noise = 2.0, depth_noise = 1.0;
+  int views = 20, intrinsics_views = 15;
+  std::uint64_t seed = 1;
+  bool json = false;
+};
+
+int write_boards(const BoardsOpts& o) {
+  const auto cfg = config_from(o.params, "sim boards");
+  calib::Board board;
+  try {
+    board = calib::Board::parse(o.size, o.square_m);
+  } catch (const calib::CalibError& e) {
+    throw UsageError(e.what());
+  }
+  const calib::Intrinsics k;  // Kinect-like
+  std::vector<Eigen::Isometry3d> sensors;
+  for (const auto& s : cfg.sensors) sensors.push_back(s.world_from_sensor());
+  const Eigen::Vector3d centre(0, 1.2, 0);
+  const auto fail_write = [](const std::string& f) { throw UsageError(f + ": cannot write the image"); };
+  std::vector<Eigen::Isometry3d> shared;
+  try {
+    shared = calib::board_poses_seen_by(sensors, board, k, o.views, centre, o.seed);
+  } catch (const calib::CalibError& e) {
+    throw UsageError(std::string(e.what()) + " (sensors too far apart for one board?)");
+  }
+  std::size_t images = 0;
+  for (std::size_t si = 0; si < sensors.size(); ++si) {
+    const std::filesystem::path dir = std::filesystem::path(o.dir) / cfg.sensors[si].id;
+    std::filesystem::create_directories(dir / "intrinsics");
+    char name[32];
+    for (std::size_t v = 0; v < shared.size(); ++v) {
+      const auto view = calib::render_board_view(board, k, calib::camera_from_board(sensors[si], shared[v]), o.grey_noise,
+                                                 o.depth_noise, o.seed * 1000003 + 1000 * si + v);
+      std::snprintf(name, sizeof name, "%03zu", v);
+      if (!cv::imwrite((dir / (std::string(name) + "_color.png")).string(), view.grey)) fail_write(name);
+      if (!cv::imwrite((dir / (std::string(name) + "_depth.png")).string(), view.depth_mm)) fail_write(name);
+      images += 2;
+    }
+    const Eigen::Vector3d in_front = cfg.sensors[si].position + 0.55 * (centre - cfg.sensors[si].position);
+    const auto own = calib::board_poses_seen_by({sensors[si]}, board, k, o.intrinsics_views, in_front, o.seed + 7 * si + 1);
+    for (std::size_t v = 0; v < own.size(); ++v) {
+      const auto view = calib::render_board_view(board, k, calib::camera_from_board(sensors[si], own[v]), o.grey_noise,
+                                                 o.depth_noise, o.seed * 7919 + 1000 * si + v);
+      std::snprintf(name, sizeof name, "%03zu", v);
+      if (!cv::imwrite((dir / "intrinsics" / (std::string(name) + "_color.png")).string(), view.grey)) fail_write(name);
+      ++images;
+    }
+    calib::write_intrinsics_file((dir / "intrinsics_truth.yaml").string(), k, 0.0, 0, "the simulated camera's true intrinsics");
+    if (!o.json) std::fprintf(stderr, "%s: %zu shared views, %zu intrinsics views\n", cfg.sensors[si].id.c_str(), shared.size(), own.size());
+  }
+  calib::CalibFile truth;
+  truth.comment = "the simulator's true sensor poses (skelgraph sim boards)";
+  for (std::size_t si = 0; si < sensors.size(); ++si) {
+    skeleton::SensorPose p;
+    p.sensor_id = cfg.sensors[si].id;
+    p.pose = sensors[si];
+    p.method = "ground_truth";
+    truth.sensors.push_back(p);
+  }
+  calib::write_calib_file((std::filesystem::path(o.dir) / "truth.yaml").string(), truth);
+  if (o.json) std::printf("%s\n", nlohmann::json{{"dir", o.dir}, {"sensors", sensors.size()}, {"views", shared.size()}, {"images", images}}.dump(2).c_str());
+  else std::printf("%s: %zu images for %zu sensors, truth in truth.yaml\n", o.dir.c_str(), images, sensors.size());
+  return 0;
+}
+
 int export_run(const std::vector<std::string>& assignments, const std::string& dir, bool json) {
   const auto cfg = config_from(assignments, "sim export");
   sim::Simulation sim(cfg);
@@ -221,6 +297,20 @@ void add_sim_command(CLI::App& app, GlobalOptions&, Action& run) {
   ps->add_option("-p,--param", po->params, "sim parameter as KEY=VALUE (sensor_count, sensors)");
   ps->add_flag("--json", po->json, "machine-readable summary");
   ps->callback([po, &run] { run = [po] { return write_poses(po->params, po->dir, po->json); }; });
+
+  auto bo = std::make_shared<BoardsOpts>();
+  auto* b = cmd->add_subcommand("boards", "Render synthetic checkerboard views (colour + depth) of the simulated cell to calibrate from");
+  b->add_option("directory", bo->dir, "output directory (created)")->required();
+  b->add_option("-p,--param", bo->params, "sim parameter as KEY=VALUE (sensor_count, sensors)");
+  b->add_option("--views", bo->views, "views every sensor sees (default 20)")->check(CLI::Range(3, 500));
+  b->add_option("--intrinsics-views", bo->intrinsics_views, "views per sensor for its intrinsics (default 15)")->check(CLI::Range(3, 500));
+  b->add_option("--board", bo->size, "inner corners COLSxROWS (default 9x6)");
+  b->add_option("--square", bo->square_m, "square size, m (default 0.08)")->check(kPositive);
+  b->add_option("--grey-noise", bo->grey_noise, "image noise, grey levels (default 2)")->check(kNonNegative);
+  b->add_option("--depth-noise", bo->depth_noise, "scale of Kinect-like depth noise (default 1)")->check(kNonNegative);
+  b->add_option("--seed", bo->seed, "random seed");
+  b->add_flag("--json", bo->json, "machine-readable summary");
+  b->callback([bo, &run] { run = [bo] { return write_boards(*bo); }; });
 }
 
 }  // namespace skelgraph::cli

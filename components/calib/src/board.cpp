@@ -34,9 +34,7 @@ std::vector<Vector3d> Board::object_points() const {
   return p;
 }
 
-cv::Mat Intrinsics::camera_matrix() const { return (cv::Mat_<double>(3, 3) << fx, 0, cx, 0, fy, cy, 0, 0, 1); }
-
-Vector3d Intrinsics::ray(double u, double v) const { return {(u - cx) / fx, (v - cy) / fy, 1.0}; }
+cv::Mat camera_matrix(const Intrinsics& k) { return (cv::Mat_<double>(3, 3) << k.fx, 0, k.cx, 0, k.fy, k.cy, 0, 0, 1); }
 
 Eigen::Matrix3d sensor_from_camera() { return Eigen::Vector3d(-1, -1, 1).asDiagonal(); }
 

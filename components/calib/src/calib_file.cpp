@@ -98,4 +98,57 @@ void write_calib_file(const std::string& path, const CalibFile& f) {
   if (!out.flush()) throw CalibFileError(path + ": cannot write the file");
 }
 
+Intrinsics read_intrinsics_file(const std::string& path) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    throw CalibFileError(path + ": cannot read the file");
+  } catch (const YAML::ParserException& e) {
+    throw CalibFileError(path + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) + ": " + e.msg);
+  }
+  if (!root.IsMap() || !root["version"] || root["version"].as<std::string>("") != "1") {
+    fail(path, root, "expected an intrinsics file with 'version: 1'");
+  }
+  Intrinsics k;
+  const auto number = [&](const char* key) {
+    if (!root[key]) fail(path, root, std::string("missing '") + key + "'");
+    try {
+      return root[key].as<double>();
+    } catch (const YAML::Exception&) {
+      fail(path, root[key], std::string("'") + key + "' expects a number");
+    }
+  };
+  k.width = static_cast<int>(number("width"));
+  k.height = static_cast<int>(number("height"));
+  k.fx = number("fx");
+  k.fy = number("fy");
+  k.cx = number("cx");
+  k.cy = number("cy");
+  if (!(k.fx > 0 && k.fy > 0 && k.width > 0 && k.height > 0)) fail(path, root, "fx, fy, width and height must be > 0");
+  if (root["distortion"]) {
+    const auto n = root["distortion"].size();
+    if (n != 0 && n != 4 && n != 5 && n != 8) fail(path, root["distortion"], "'distortion' expects 0, 4, 5 or 8 numbers");
+    k.distortion = numbers(path, root, "distortion", n);
+  }
+  return k;
+}
+
+void write_intrinsics_file(const std::string& path, const Intrinsics& k, double rms_reprojection_px, std::size_t views,
+                           const std::string& comment) {
+  YAML::Emitter e;
+  e.SetDoublePrecision(9);
+  e << YAML::BeginMap << YAML::Key << "version" << YAML::Value << 1;
+  e << YAML::Key << "width" << YAML::Value << k.width << YAML::Key << "height" << YAML::Value << k.height;
+  e << YAML::Key << "fx" << YAML::Value << k.fx << YAML::Key << "fy" << YAML::Value << k.fy;
+  e << YAML::Key << "cx" << YAML::Value << k.cx << YAML::Key << "cy" << YAML::Value << k.cy;
+  e << YAML::Key << "distortion" << YAML::Value << YAML::Flow << k.distortion;
+  e << YAML::Key << "rms_reprojection_px" << YAML::Value << rms_reprojection_px;
+  e << YAML::Key << "views" << YAML::Value << views << YAML::EndMap;
+  std::ofstream out(path);
+  if (!comment.empty()) out << "# " << comment << "\n";
+  out << e.c_str() << "\n";
+  if (!out.flush()) throw CalibFileError(path + ": cannot write the file");
+}
+
 }  // namespace skelgraph::calib

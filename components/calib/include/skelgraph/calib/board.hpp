@@ -15,6 +15,7 @@
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
+#include "skelgraph/calib/intrinsics.hpp"
 #include "skelgraph/calib/rigid.hpp"
 
 namespace skelgraph::calib {
@@ -28,13 +29,7 @@ struct Board {
   std::vector<Eigen::Vector3d> object_points() const;
 };
 
-struct Intrinsics {
-  int width = 640, height = 480;
-  double fx = 525, fy = 525, cx = 319.5, cy = 239.5;
-  std::vector<double> distortion;  // OpenCV order k1 k2 p1 p2 k3; empty: none
-  cv::Mat camera_matrix() const;
-  Eigen::Vector3d ray(double u, double v) const;  // (x, y, 1) of pixel (u, v), distortion ignored
-};
+cv::Mat camera_matrix(const Intrinsics& k);
 
 Eigen::Matrix3d sensor_from_camera();  // diag(-1, -1, 1)
 

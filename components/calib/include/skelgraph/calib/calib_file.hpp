@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "skelgraph/calib/intrinsics.hpp"
 #include "skelgraph/skeleton/skeleton_msg.hpp"
 
 namespace skelgraph::calib {
@@ -38,5 +39,12 @@ struct CalibFile {
 // Throws CalibFileError naming file:line and what was expected.
 CalibFile read_calib_file(const std::string& path);
 void write_calib_file(const std::string& path, const CalibFile& file);
+
+// Intrinsics files (YAML): version: 1, width, height, fx, fy, cx, cy,
+// distortion: [k1, k2, p1, p2, k3], and how they were found
+// (rms_reprojection_px, views) when written by `skelgraph calib intrinsics`.
+Intrinsics read_intrinsics_file(const std::string& path);
+void write_intrinsics_file(const std::string& path, const Intrinsics& k, double rms_reprojection_px, std::size_t views,
+                           const std::string& comment);
 
 }  // namespace skelgraph::calib
