@@ -189,7 +189,8 @@ Alignment propose(const std::vector<Candidate>& cs, const std::vector<JointId>& 
 // pose from a single frame is already robust (it won the frame-level RANSAC),
 // so each round refits on the joint pairs within the threshold of the
 // current pose (a minimal-sample RANSAC over single joints would be at the
-// mercy of a few centimetres of noise on three points).
+// mercy of a few centimetres of noise on three points), weighted by their
+// residuals (Cauchy).
 SkeletonCalibResult solve(const std::vector<Candidate>& cs, Alignment pose, const std::vector<JointId>& joints,
                           const SkeletonCalibOptions& o) {
   SkeletonCalibResult r;
@@ -209,7 +210,15 @@ SkeletonCalibResult solve(const std::vector<Candidate>& cs, Alignment pose, cons
                        std::to_string(o.inlier_threshold_m) + " m (" + std::to_string(p.matched) + " frames matched, " +
                        std::to_string(p.flipped) + " flipped)");
     }
-    const Alignment fit = align(a, b);
+    // Robust weights (Cauchy, scale c): a joint the tracker placed far off
+    // (hidden behind the body, still claimed) pulls less than a clean one.
+    std::vector<double> w;
+    const double c = o.robust_scale_m;
+    for (std::size_t k = 0; k < a.size(); ++k) {
+      const double r = (pose.apply(a[k]) - b[k]).norm();
+      w.push_back(c > 0 && round > 0 ? 1.0 / (1.0 + (r / c) * (r / c)) : 1.0);
+    }
+    const Alignment fit = align(a, b, w);
     const double moved = (fit.t - pose.t).norm() + 0.01 * rotation_angle_deg(fit.R * pose.R.transpose());
     pose = fit;
     r.fit = fit;

@@ -12,8 +12,10 @@
 // 3. Under the best pose every reference person gets its match; frames whose
 //    match fits better swapped (one sensor sees the back and flipped the
 //    sides) are rejected, as are matches that fit badly (a different person,
-//    a ghost). The joint pairs left are solved by RANSAC + SVD; pairing and
-//    solving repeat until the pose settles.
+//    a ghost). The joint pairs left within the threshold are solved by
+//    weighted SVD (Cauchy weights on the residuals: a joint hidden behind the
+//    body but still claimed pulls less); pairing and solving repeat until the
+//    pose settles.
 //
 // Everything is in the sensors' own frames; the result maps the other
 // sensor's frame into the reference sensor's.
@@ -39,6 +41,7 @@ struct SkeletonCalibOptions {
   std::int64_t max_clock_offset_ns = 0;          // search the other sensor's clock offset within +-this
   double inlier_threshold_m = 0.12;              // a joint pair agrees this well under a good pose
   double match_median_m = 0.20;                  // a person match whose median joint distance exceeds this is not one
+  double robust_scale_m = 0.05;                  // Cauchy weights 1 / (1 + (r / this)^2) in the refits (0: none)
   int hypotheses = 300;                          // frame-level RANSAC samples
   std::size_t max_scored_frames = 1500;          // hypotheses are scored on at most this many frames (evenly spread)
   std::uint64_t seed = 1;
