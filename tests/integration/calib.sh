@@ -48,6 +48,12 @@ done
 json_check "$WORK/board.json" 'd["views_used"] == 20 and d["rms_residual_cm"] < 1'
 compare_pose "$WORK/boards/truth.yaml" "$WORK/board_calib.yaml" 0.01 0.5 || fail "board calibration against the truth"
 ok "checkerboard: intrinsics within 1 %, sensor2 within 1 cm and 0.5 degree of the truth from 20 views"
+# To the motion-capture frame, as the thesis did: the board's markers seen by motion capture place its corners in the world.
+"$S" calib board "$WORK/boards/sensor2" --ref sensor2 --world-markers "$WORK/boards/markers.yaml" \
+  --out "$WORK/world2.yaml" --json >"$WORK/world.json" 2>"$WORK/world.err" || fail "calib board --world-markers: $(cat "$WORK/world.err")"
+json_check "$WORK/world.json" 'd["reference"] == "world" and d["views_used"] == 20 and d["marker_fit_rms_cm_worst"] < 0.2'
+compare_pose "$WORK/boards/truth.yaml" "$WORK/world2.yaml" 0.01 0.5 || fail "board-to-world calibration against the truth"
+ok "checkerboard with motion-capture markers: sensor2 in the world within 1 cm and 0.5 degree"
 
 # Bad input: a sensor that is not there, a malformed calibration file, missing intrinsics.
 set +e

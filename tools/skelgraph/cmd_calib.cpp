@@ -253,6 +253,7 @@ struct BoardOptions {
   std::string size = "9x6";
   double square_m = 0.08;
   std::string ref_intrinsics, other_intrinsics, ref_pose, out;
+  std::string world_markers;  // one directory: its sensor to the motion-capture frame
   bool json = false;
 };
 
@@ -347,22 +348,43 @@ calib::Intrinsics intrinsics_for(const std::string& dir, const std::string& give
 
 int calib_board(const BoardOptions& o) {
   const auto board = board_of(o);
-  const auto kr = intrinsics_for(o.ref_dir, o.ref_intrinsics);
-  const auto ko = intrinsics_for(o.other_dir, o.other_intrinsics);
+  // Two directories: the other sensor against the reference. One directory
+  // and --world-markers: that sensor against the motion-capture frame, the
+  // board's corners placed in it by its markers.
+  const bool world = !o.world_markers.empty();
+  if (world == !o.other_dir.empty()) {
+    throw UsageError("give either two view directories (sensor to sensor) or one with --world-markers (sensor to world)");
+  }
+  calib::BoardMarkers markers;
+  if (world) {
+    try {
+      markers = calib::read_board_markers(o.world_markers);
+    } catch (const calib::CalibFileError& e) {
+      throw UsageError(e.what());
+    }
+  }
+  const std::vector<std::string> dirs = world ? std::vector<std::string>{o.ref_dir} : std::vector<std::string>{o.ref_dir, o.other_dir};
+  std::vector<calib::Intrinsics> ks{intrinsics_for(o.ref_dir, o.ref_intrinsics)};
+  if (!world) ks.push_back(intrinsics_for(o.other_dir, o.other_intrinsics));
   std::vector<std::vector<Eigen::Vector3d>> ref, other;
   std::vector<std::string> used, skipped;
+  std::vector<double> marker_rms;
   const auto names = view_names(o.ref_dir);
   if (names.empty()) throw UsageError(o.ref_dir + ": no NAME_color.png views");
   for (std::size_t i = 0; i < names.size(); ++i) {
     const auto& n = names[i];
-    std::vector<Eigen::Vector3d> lifted[2];
+    std::vector<std::vector<Eigen::Vector3d>> lifted(dirs.size());
     bool ok = true;
-    for (int c = 0; c < 2 && ok; ++c) {
-      const std::filesystem::path dir = c == 0 ? o.ref_dir : o.other_dir;
+    if (world && !markers.in_world.count(n)) {
+      skipped.push_back(n + ": no markers for this view in " + o.world_markers);
+      ok = false;
+    }
+    for (std::size_t c = 0; c < dirs.size() && ok; ++c) {
+      const std::filesystem::path dir = dirs[c];
       const auto colour = (dir / (n + "_color.png")).string(), depth = (dir / (n + "_depth.png")).string();
       if (!std::filesystem::exists(colour) || !std::filesystem::exists(depth)) {
         ok = false;
-        skipped.push_back(n + ": not in both directories with colour and depth");
+        skipped.push_back(n + (world ? ": no colour and depth image" : ": not in both directories with colour and depth"));
         break;
       }
       const auto corners = calib::find_corners(read_image(colour, cv::IMREAD_GRAYSCALE), board);
@@ -374,7 +396,7 @@ int calib_board(const BoardOptions& o) {
       const cv::Mat d = read_image(depth, cv::IMREAD_ANYDEPTH);
       if (d.type() != CV_16U) throw UsageError(depth + ": expected a 16-bit depth image (millimetres)");
       try {
-        lifted[c] = calib::lift_corners(*corners, d, c == 0 ? kr : ko, board).points;
+        lifted[c] = calib::lift_corners(*corners, d, ks[c], board).points;
       } catch (const calib::CalibError& e) {
         ok = false;
         skipped.push_back(n + ": " + e.what());
@@ -382,8 +404,23 @@ int calib_board(const BoardOptions& o) {
     }
     if (!o.json) std::fprintf(stderr, "\rviews: %zu of %zu read", i + 1, names.size());
     if (!ok) continue;
-    ref.push_back(std::move(lifted[0]));
-    other.push_back(std::move(lifted[1]));
+    if (world) {
+      // The board in the world from its markers, then its corners there.
+      calib::Alignment wb;
+      try {
+        wb = calib::align(markers.in_board, markers.in_world.at(n));
+      } catch (const calib::CalibError& e) {
+        throw UsageError(o.world_markers + ": view " + n + ": " + e.what());
+      }
+      marker_rms.push_back(wb.rms);
+      std::vector<Eigen::Vector3d> w;
+      for (const auto& p : board.object_points()) w.push_back(wb.apply(p));
+      ref.push_back(std::move(w));
+      other.push_back(std::move(lifted[0]));
+    } else {
+      ref.push_back(std::move(lifted[0]));
+      other.push_back(std::move(lifted[1]));
+    }
     used.push_back(n);
   }
   if (!o.json) std::fprintf(stderr, "\n");
@@ -394,19 +431,43 @@ int calib_board(const BoardOptions& o) {
   } catch (const calib::CalibError& e) {
     throw UsageError(e.what());
   }
-  // Camera frames (x right, y down) -> skelgraph sensor frames (x left, y up).
+  // Camera frames (x right, y down) -> skelgraph sensor frames (x left, y up);
+  // in world mode the reference side is the world itself.
   const Eigen::Matrix3d S = calib::sensor_from_camera();
+  const Eigen::Matrix3d L = world ? Eigen::Matrix3d::Identity() : S;
   Eigen::Isometry3d ref_from_other = Eigen::Isometry3d::Identity();
-  ref_from_other.linear() = S * r.fit.R * S.transpose();
-  ref_from_other.translation() = S * r.fit.t;
+  ref_from_other.linear() = L * r.fit.R * S.transpose();
+  ref_from_other.translation() = L * r.fit.t;
   const std::size_t corners = ref.size() * ref.front().size();
   const bool good = r.fit.rms < 0.01 && r.inliers.size() * 10 >= corners * 9;
-  nlohmann::json j{{"reference", o.ref}, {"other", o.other}, {"views", names.size()}, {"views_used", used.size()},
+  const std::string ref_name = world ? "world" : o.ref, other_name = world ? o.ref : o.other;
+  nlohmann::json j{{"reference", ref_name}, {"other", other_name}, {"views", names.size()}, {"views_used", used.size()},
                    {"skipped", skipped}, {"reference_from_other", pose_json(ref_from_other)},
                    {"corners", corners}, {"inliers", r.inliers.size()},
                    {"rms_residual_cm", cm(r.fit.rms)}, {"max_residual_cm", cm(r.fit.max)},
                    {"verdict", good ? "good: corners agree within 1 cm RMS" : "poor: corners disagree (RMS 1 cm or more, or over 10 % outliers): check the intrinsics and that the depth is registered"}};
-  if (!o.out.empty()) {
+  if (world) {
+    double worst = 0;
+    for (double m : marker_rms) worst = std::max(worst, m);
+    j["marker_fit_rms_cm_worst"] = cm(worst);
+  }
+  if (!o.out.empty() && world) {
+    calib::CalibFile f;
+    f.comment = "written by skelgraph calib board " + o.ref_dir + " --world-markers " + o.world_markers;
+    skeleton::SensorPose p;
+    p.sensor_id = o.ref;
+    p.pose = ref_from_other;
+    p.method = "checkerboard";
+    p.rms_residual_m = r.fit.rms;
+    p.max_residual_m = r.fit.max;
+    f.sensors = {p};
+    try {
+      calib::write_calib_file(o.out, f);
+    } catch (const calib::CalibFileError& e) {
+      throw UsageError(e.what());
+    }
+    j["written"] = o.out;
+  } else if (!o.out.empty()) {
     Eigen::Isometry3d world_from_ref = Eigen::Isometry3d::Identity();
     std::string ref_method = "reference";
     if (!o.ref_pose.empty()) {
@@ -446,7 +507,7 @@ int calib_board(const BoardOptions& o) {
     const auto& p = j["reference_from_other"];
     std::printf("%s from %s: %zu of %zu views used; rotation %.2f deg, translation [%.3f, %.3f, %.3f] m\n"
                 "%zu of %zu corners within 2 cm, RMS %.2f cm, max %.2f cm: %s%s\n",
-                o.other.c_str(), o.ref.c_str(), used.size(), names.size(), p["rotation_deg"].get<double>(),
+                other_name.c_str(), ref_name.c_str(), used.size(), names.size(), p["rotation_deg"].get<double>(),
                 p["translation_m"][0].get<double>(), p["translation_m"][1].get<double>(), p["translation_m"][2].get<double>(),
                 r.inliers.size(), corners, cm(r.fit.rms), cm(r.fit.max), j["verdict"].get<std::string>().c_str(),
                 o.out.empty() ? "" : ("; written to " + o.out).c_str());
@@ -494,14 +555,17 @@ void add_calib_command(CLI::App& app, GlobalOptions&, Action& run) {
 
   auto* bo = cal->add_subcommand(
       "board",
-      "Extrinsics between two sensors from a checkerboard both see: corners found in each colour image, lifted to 3-D "
-      "with the depth image, all views aligned by SVD");
+      "Extrinsics from a checkerboard: between two sensors that both see it, or of one sensor to a motion-capture frame "
+      "(--world-markers); corners found in each colour image, lifted to 3-D with the depth image, all views aligned by SVD");
   bo->add_option("ref_dir", b->ref_dir, "reference sensor's views: NAME_color.png + NAME_depth.png (16-bit mm)")
       ->required()
       ->check(CLI::ExistingDirectory);
-  bo->add_option("other_dir", b->other_dir, "the other sensor's views, same NAMEs taken at the same moments")
-      ->required()
+  bo->add_option("other_dir", b->other_dir, "the other sensor's views, same NAMEs taken at the same moments (omit with --world-markers)")
       ->check(CLI::ExistingDirectory);
+  bo->add_option("--world-markers", b->world_markers,
+                 "board markers file (markers on the board, and per view where motion capture saw them): calibrate "
+                 "REF_DIR's sensor (--ref) to the motion-capture frame")
+      ->check(CLI::ExistingFile);
   bo->add_option("--ref", b->ref, "reference sensor id (default sensor1)");
   bo->add_option("--other", b->other, "other sensor id (default sensor2)");
   bo->add_option("--board", b->size, "inner corners COLSxROWS (default 9x6)");

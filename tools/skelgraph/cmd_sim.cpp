@@ -130,7 +130,8 @@ int write_poses(const std::vector<std::string>& assignments, const std::string& 
 // DIR/<sensor>/NNN_color.png + NNN_depth.png (the board where every sensor
 // sees it, the same NNN at the same moment), DIR/<sensor>/intrinsics/ (views
 // for that sensor's intrinsics), and the truth: DIR/truth.yaml (poses) and
-// DIR/<sensor>/intrinsics_truth.yaml.
+// DIR/<sensor>/intrinsics_truth.yaml; and DIR/markers.yaml, the board's
+// motion-capture markers in each shared view (for calib board --world-markers).
 struct BoardsOpts {
   std::string dir, size = "9x6";
   std::vector<std::string> params;
@@ -194,6 +195,22 @@ int write_boards(const BoardsOpts& o) {
     truth.sensors.push_back(p);
   }
   calib::write_calib_file((std::filesystem::path(o.dir) / "truth.yaml").string(), truth);
+  // Motion-capture markers on the board (four round its edge, one on a
+  // stalk), seen in the world with 0.5 mm of noise.
+  calib::BoardMarkers markers;
+  const double w = (board.cols - 1) * board.square_m, h = (board.rows - 1) * board.square_m;
+  markers.in_board = {{-0.12, -0.12, 0}, {w + 0.12, -0.12, 0}, {-0.12, h + 0.12, 0}, {w + 0.12, h + 0.1, 0}, {0.5 * w, -0.12, -0.05}};
+  cv::RNG mrng(o.seed + 99);
+  char vname[32];
+  for (std::size_t v = 0; v < shared.size(); ++v) {
+    std::snprintf(vname, sizeof vname, "%03zu", v);
+    auto& pts = markers.in_world[vname];
+    for (const auto& m : markers.in_board) {
+      pts.push_back(shared[v] * m + Eigen::Vector3d(mrng.gaussian(5e-4), mrng.gaussian(5e-4), mrng.gaussian(5e-4)));
+    }
+  }
+  calib::write_board_markers((std::filesystem::path(o.dir) / "markers.yaml").string(), markers,
+                             "the board's motion-capture markers in every shared view (skelgraph sim boards)");
   if (o.json) std::printf("%s\n", nlohmann::json{{"dir", o.dir}, {"sensors", sensors.size()}, {"views", shared.size()}, {"images", images}}.dump(2).c_str());
   else std::printf("%s: %zu images for %zu sensors, truth in truth.yaml\n", o.dir.c_str(), images, sensors.size());
   return 0;

@@ -98,6 +98,78 @@ void write_calib_file(const std::string& path, const CalibFile& f) {
   if (!out.flush()) throw CalibFileError(path + ": cannot write the file");
 }
 
+namespace {
+std::vector<Eigen::Vector3d> points(const std::string& path, const YAML::Node& parent, const char* key) {
+  const auto n = parent[key];
+  if (!n || !n.IsSequence() || n.size() < 3) fail(path, n ? n : parent, std::string("'") + key + "' expects a list of at least 3 [x, y, z] points");
+  std::vector<Eigen::Vector3d> out;
+  for (const auto& p : n) {
+    if (!p.IsSequence() || p.size() != 3) fail(path, p, std::string("'") + key + "' expects [x, y, z] points");
+    Eigen::Vector3d v;
+    for (int i = 0; i < 3; ++i) {
+      try {
+        v[i] = p[i].as<double>();
+      } catch (const YAML::Exception&) {
+        fail(path, p[i], std::string("'") + key + "' expects numbers");
+      }
+    }
+    out.push_back(v);
+  }
+  return out;
+}
+}  // namespace
+
+BoardMarkers read_board_markers(const std::string& path) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    throw CalibFileError(path + ": cannot read the file");
+  } catch (const YAML::ParserException& e) {
+    throw CalibFileError(path + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) + ": " + e.msg);
+  }
+  if (!root.IsMap() || !root["version"] || root["version"].as<std::string>("") != "1") {
+    fail(path, root, "expected a board markers file with 'version: 1'");
+  }
+  BoardMarkers m;
+  m.in_board = points(path, root, "markers_in_board");
+  const auto views = root["views"];
+  if (!views || !views.IsSequence()) fail(path, root, "expected 'views': a list of {name, markers_in_world}");
+  for (const auto& v : views) {
+    if (!v.IsMap() || !v["name"]) fail(path, v, "each view needs a 'name'");
+    auto w = points(path, v, "markers_in_world");
+    if (w.size() != m.in_board.size()) {
+      fail(path, v["markers_in_world"], std::to_string(w.size()) + " markers, but markers_in_board lists " + std::to_string(m.in_board.size()));
+    }
+    m.in_world[v["name"].as<std::string>()] = std::move(w);
+  }
+  return m;
+}
+
+void write_board_markers(const std::string& path, const BoardMarkers& m, const std::string& comment) {
+  const auto seq = [](YAML::Emitter& e, const std::vector<Eigen::Vector3d>& pts) {
+    e << YAML::BeginSeq;
+    for (const auto& p : pts) e << YAML::Flow << std::vector<double>{p.x(), p.y(), p.z()};
+    e << YAML::EndSeq;
+  };
+  YAML::Emitter e;
+  e.SetDoublePrecision(9);
+  e << YAML::BeginMap << YAML::Key << "version" << YAML::Value << 1 << YAML::Key << "markers_in_board" << YAML::Value;
+  seq(e, m.in_board);
+  e << YAML::Key << "views" << YAML::Value << YAML::BeginSeq;
+  for (const auto& [name, pts] : m.in_world) {
+    e << YAML::BeginMap << YAML::Key << "name" << YAML::Value << YAML::DoubleQuoted << name << YAML::Key
+      << "markers_in_world" << YAML::Value;
+    seq(e, pts);
+    e << YAML::EndMap;
+  }
+  e << YAML::EndSeq << YAML::EndMap;
+  std::ofstream out(path);
+  if (!comment.empty()) out << "# " << comment << "\n";
+  out << e.c_str() << "\n";
+  if (!out.flush()) throw CalibFileError(path + ": cannot write the file");
+}
+
 Intrinsics read_intrinsics_file(const std::string& path) {
   YAML::Node root;
   try {

@@ -16,6 +16,7 @@
 // The `calibration` component publishes it on skelgraph/calibration, where
 // fusion takes its sensor poses from.
 
+#include <map>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -39,6 +40,23 @@ struct CalibFile {
 // Throws CalibFileError naming file:line and what was expected.
 CalibFile read_calib_file(const std::string& path);
 void write_calib_file(const std::string& path, const CalibFile& file);
+
+// Board markers (YAML), to calibrate a sensor to a motion-capture (world)
+// frame with a board as the thesis did: the markers' positions on the board
+// (board frame: x along the corner rows, y down the columns, origin at the
+// first inner corner; m) and, per view NAME, where the motion-capture system
+// saw them (world, m, same order).
+//   version: 1
+//   markers_in_board: [[-0.1, -0.1, 0], ...]
+//   views:
+//     - name: "000"
+//       markers_in_world: [[x, y, z], ...]
+struct BoardMarkers {
+  std::vector<Eigen::Vector3d> in_board;
+  std::map<std::string, std::vector<Eigen::Vector3d>> in_world;  // by view name
+};
+BoardMarkers read_board_markers(const std::string& path);
+void write_board_markers(const std::string& path, const BoardMarkers& m, const std::string& comment);
 
 // Intrinsics files (YAML): version: 1, width, height, fx, fy, cx, cy,
 // distortion: [k1, k2, p1, p2, k3], and how they were found
