@@ -63,7 +63,9 @@ import json, sys
 ev, fu, info = (json.load(open(p)) for p in sys.argv[1:4])
 assert ev["has_truth"] and ev["ticks"] > 100, ev["ticks"]
 s = {x["stream"]: x for x in ev["streams"]}
-assert set(s) == {"sensor1", "sensor2", "avg", "sum", "facing", "weighted", "kalman"}, set(s)
+# single sensors, every method re-run offline, and what the live fusion component published (recorded)
+assert set(s) == {"sensor1", "sensor2", "avg", "sum", "facing", "weighted", "kalman", "live fused"}, set(s)
+assert s["live fused"]["ticks_with_output"] > 100 and 0 < s["live fused"]["mean_error_cm"] < 100, s["live fused"]
 shoulders = lambda k: s[k]["groups"]["Shoulders"]["detection_pct"]
 for m in ("avg", "sum", "kalman"):
     assert shoulders(m) >= max(shoulders("sensor1"), shoulders("sensor2")) - 0.5, (m, shoulders(m))

@@ -301,7 +301,24 @@ struct Fuser::Impl {
         if (v->s.joints[j].confidence >= kInferred) meas.emplace_back(v, measurement_sigma(*v, j));
       }
       bool tracked = false, any = false;
-      if (!f.initialised() || tr.misses[j] >= kResetAfterMisses) {
+      // Every sensor's measurement fell outside the gate, but two or more of
+      // them agree with each other: it is the filter that is off (a fast
+      // movement its constant velocity did not follow), not the sensors.
+      bool sensors_agree_against_filter = false;
+      if (f.initialised() && meas.size() >= 2 && tr.misses[j] < kResetAfterMisses) {
+        bool all_gated = true;
+        for (const auto& [v, sg] : meas) all_gated = all_gated && f.mahalanobis2(v->s.joints[j].position, sg) > kGate;
+        bool agree = all_gated;
+        for (std::size_t a = 0; agree && a < meas.size(); ++a) {
+          for (std::size_t b = a + 1; agree && b < meas.size(); ++b) {
+            const double sa = meas[a].second, sb = meas[b].second;
+            const double d = (meas[a].first->s.joints[j].position - meas[b].first->s.joints[j].position).norm();
+            agree = d * d <= kGate * (sa * sa + sb * sb);
+          }
+        }
+        sensors_agree_against_filter = agree;
+      }
+      if (!f.initialised() || tr.misses[j] >= kResetAfterMisses || sensors_agree_against_filter) {
         // Start from the confidence-weighted mean of what the sensors say.
         Vector3d sum = Vector3d::Zero();
         double wsum = 0, sig = 0;
