@@ -14,6 +14,7 @@
 #include "cli.hpp"
 #include "eval_sim.hpp"
 #include "report.hpp"
+#include "skelgraph/calib/calib_file.hpp"
 #include "skelgraph/eval/offline.hpp"
 #include "skelgraph/mcap/mcap.hpp"
 #include "skelgraph/msg/cdr.hpp"
@@ -175,7 +176,8 @@ struct RecordingInputs {
 
 // shared_frame: every sensor's skeletons are already in one frame (data sets
 // such as KinectMultiTrack map them so): identity poses, no calibration needed.
-RecordingInputs read_recording(const std::string& file, bool shared_frame) {
+// calibration: a calibration file whose poses replace the recording's.
+RecordingInputs read_recording(const std::string& file, bool shared_frame, const std::string& calibration = "") {
   RecordingInputs in;
   try {
     const mcap::Reader reader(file);
@@ -209,8 +211,15 @@ RecordingInputs read_recording(const std::string& file, bool shared_frame) {
   std::stable_sort(in.events.begin(), in.events.end(),
                    [](const eval::TimedSkeleton& a, const eval::TimedSkeleton& b) { return a.t_ns < b.t_ns; });
   if (in.raw == 0) throw UsageError(file + ": no raw skeletons on " + runtime::topics::kSkeletonRaw.name);
+  if (!calibration.empty()) {
+    try {
+      for (const auto& p : calib::read_calib_file(calibration).sensors) in.poses[p.sensor_id] = p.pose;
+    } catch (const calib::CalibFileError& e) {
+      throw UsageError(e.what());
+    }
+  }
   for (const auto& e : in.events) {
-    if (shared_frame && e.kind == eval::TimedSkeleton::Kind::Raw) in.poses[e.skeleton.sensor_id] = Eigen::Isometry3d::Identity();
+    if (shared_frame && e.kind == eval::TimedSkeleton::Kind::Raw) in.poses.try_emplace(e.skeleton.sensor_id, Eigen::Isometry3d::Identity());
     if (e.kind == eval::TimedSkeleton::Kind::Raw && !in.poses.count(e.skeleton.sensor_id)) {
       throw UsageError(file + ": no pose of sensor '" + e.skeleton.sensor_id + "' on " +
                        runtime::topics::kCalibration.name + " (calibrate it, record the calibration topic, or --shared-frame if the data is already in one frame)");
@@ -224,6 +233,7 @@ struct FileOptions {
   std::vector<std::string> methods;
   double delay_ms = 0, max_age_ms = 100;
   bool json = false, shared_frame = false;
+  std::string calibration;  // a calibration file's poses instead of the recording's
 };
 
 eval::OfflineOptions offline_options(const std::vector<std::string>& methods, double delay_ms, double max_age_ms) {
@@ -246,7 +256,7 @@ eval::OfflineOptions offline_options(const FileOptions& o, const RecordingInputs
 // skelgraph eval FILE: single sensors and every method, against the truth in the
 // recording if it has one; bone-length steadiness and completeness either way.
 int eval_file(const FileOptions& o) {
-  const auto in = read_recording(o.file, o.shared_frame);
+  const auto in = read_recording(o.file, o.shared_frame, o.calibration);
   auto eo = offline_options(o, in);
   eo.trace = !o.report_dir.empty();
   const auto r = eval::evaluate(in.poses, in.events, eo);
@@ -284,7 +294,7 @@ int eval_file(const FileOptions& o) {
 // skelgraph fuse IN --out OUT: the recording with fused skeletons added on
 // skelgraph/skeleton/fused (sensor_id "fused", or "fused_<method>" for several).
 int fuse_file(const FileOptions& o) {
-  const auto in = read_recording(o.file, o.shared_frame);
+  const auto in = read_recording(o.file, o.shared_frame, o.calibration);
   auto eo = offline_options(o, in);
   eo.singles = false;  // only the methods go into the file
   std::vector<std::pair<std::int64_t, skeleton::Skeleton>> fused;
@@ -443,6 +453,8 @@ void add_fuse_command(CLI::App& app, GlobalOptions&, Action& run) {
                      "fusion method(s); several: sensor_id fused_<method> each (default kalman)");
   f->add_flag("--json", o->json, "machine-readable summary");
   f->add_flag("--shared-frame", o->shared_frame, "the sensors' skeletons are already in one frame (e.g. KinectMultiTrack): no poses needed");
+  f->add_option("--calibration", o->calibration, "sensor poses from this calibration file (YAML) instead of the recording's")
+      ->check(CLI::ExistingFile);
   f->callback([o, &run] {
     if (o->methods.empty()) o->methods = {"kalman"};
     run = [o] { return fuse_file(*o); };
@@ -469,6 +481,8 @@ void add_eval_command(CLI::App& app, GlobalOptions&, Action& run) {
   add_fusion_options(r, fo->methods, fo->delay_ms, fo->max_age_ms, "fusion methods (default: all)");
   r->add_flag("--json", fo->json, "machine-readable results");
   r->add_flag("--shared-frame", fo->shared_frame, "the sensors' skeletons are already in one frame (e.g. KinectMultiTrack): no poses needed");
+  r->add_option("--calibration", fo->calibration, "sensor poses from this calibration file (YAML) instead of the recording's")
+      ->check(CLI::ExistingFile);
   r->add_option("--report", fo->report_dir, "also write DIR/report.html (table, inline SVG plots) and each plot as SVG");
   r->callback([fo, &run] { run = [fo] { return eval_file(*fo); }; });
 }

@@ -153,7 +153,7 @@ void Steadiness::add(const skeleton::Skeleton& s) {
   for (const auto& b : kBones) {
     if (s[b.a].confidence < skeleton::kTracked || s[b.b].confidence < skeleton::kTracked) continue;
     const double len = (s[b.a].position - s[b.b].position).norm();
-    auto& m = bones_[b.name];
+    auto& m = bones_[{b.name, s.person_id}];
     m.n += 1;
     m.sum += len;
     m.sum2 += len * len;
@@ -165,12 +165,17 @@ double Steadiness::upper_body_complete_pct() const {
 }
 
 std::map<std::string, double> Steadiness::bone_sd_cm() const {
-  std::map<std::string, double> out;
-  for (const auto& [name, m] : bones_) {
+  // Per bone: the within-person variances, pooled by frame count.
+  std::map<std::string, std::pair<double, double>> pooled;  // bone -> (sum of n * var, sum of n)
+  for (const auto& [key, m] : bones_) {
     if (m.n < 2) continue;
     const double mean = m.sum / m.n;
-    out[name] = 100.0 * std::sqrt(std::max(0.0, m.sum2 / m.n - mean * mean));
+    auto& p = pooled[key.first];
+    p.first += m.n * std::max(0.0, m.sum2 / m.n - mean * mean);
+    p.second += m.n;
   }
+  std::map<std::string, double> out;
+  for (const auto& [name, p] : pooled) out[name] = 100.0 * std::sqrt(p.first / p.second);
   return out;
 }
 

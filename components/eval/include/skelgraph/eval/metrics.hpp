@@ -65,8 +65,9 @@ class TruthTimeline {
 
 // Bone-length steadiness, no truth needed: for each upper-body bone, the
 // standard deviation of its length over the frames where both ends have
-// confidence 1; and the share of frames with every upper-body joint at
-// confidence 1.
+// confidence 1, within each person (people's bones differ; the spread of
+// each person's about their own mean is pooled); and the share of frames
+// with every upper-body joint at confidence 1.
 class Steadiness {
  public:
   void add(const skeleton::Skeleton& s);
@@ -80,7 +81,7 @@ class Steadiness {
     double n = 0, sum = 0, sum2 = 0;
   };
   std::uint64_t frames_ = 0, complete_ = 0;
-  std::map<std::string, Moments> bones_;
+  std::map<std::pair<std::string, std::uint32_t>, Moments> bones_;  // by bone, person
 };
 
 }  // namespace skelgraph::eval
