@@ -1,0 +1,114 @@
+#pragma once
+// Continuous hidden Markov models with Gaussian-mixture emissions (full or
+// diagonal covariances), in log space throughout: forward log-likelihood,
+// Viterbi path, state posteriors, a streaming forward step for live use, and
+// Baum-Welch training over many sequences of different lengths. Eigen only;
+// models save to and load from versioned JSON.
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
+namespace skelgraph::gesture {
+
+// One observation per row: T x D.
+using Sequence = Eigen::MatrixXd;
+
+// Bad model file or bad training input; the message says what and where.
+class ModelError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+enum class Covariance { Full, Diagonal };
+
+struct GaussianMixture {
+  Eigen::VectorXd weights;               // M, sum 1
+  std::vector<Eigen::VectorXd> means;    // M x D
+  std::vector<Eigen::MatrixXd> covs;     // M x (D x D); diagonal models keep zeros off the diagonal
+  // Cached for log_pdf: inverse Cholesky factors and log normalisers.
+  void prepare();
+  double log_pdf(const Eigen::VectorXd& x) const;                      // log sum_m w_m N(x; mu_m, S_m)
+  void log_pdf_components(const Eigen::VectorXd& x, Eigen::VectorXd& out) const;  // log w_m + log N_m
+
+ private:
+  std::vector<Eigen::MatrixXd> inv_l_;  // L^-1 with S = L L^T
+  Eigen::VectorXd log_norm_;
+};
+
+struct TrainOptions {
+  int states = 7;
+  int mixtures = 1;
+  Covariance covariance = Covariance::Full;
+  bool left_right = false;      // transitions only to the same or the next state
+  int max_iterations = 100;
+  double tolerance = 1e-4;      // stop when the mean log-likelihood per frame improves less than this
+  double regularisation = 1e-3;  // added to covariance diagonals, times each dimension's variance over all data
+  std::uint64_t seed = 1;
+};
+
+struct TrainReport {
+  int iterations = 0;
+  bool converged = false;
+  std::vector<double> log_likelihood;  // total over the sequences, after initialisation and after each iteration
+};
+
+class Hmm {
+ public:
+  Hmm() = default;
+  Hmm(int states, int dim, Covariance covariance);
+
+  int states() const { return static_cast<int>(log_start_.size()); }
+  int dim() const { return dim_; }
+  Covariance covariance() const { return covariance_; }
+
+  // Parameters (probabilities, not logs), checked: rows sum to 1, weights
+  // sum to 1, covariances symmetric positive definite. Throws ModelError.
+  void set(const Eigen::VectorXd& start, const Eigen::MatrixXd& transitions, std::vector<GaussianMixture> emissions);
+  Eigen::VectorXd start() const;
+  Eigen::MatrixXd transitions() const;
+  const std::vector<GaussianMixture>& emissions() const { return emissions_; }
+
+  double log_likelihood(const Sequence& x) const;               // forward; -inf for an impossible sequence
+  std::vector<int> viterbi(const Sequence& x, double* log_prob = nullptr) const;
+  Eigen::MatrixXd posteriors(const Sequence& x) const;          // T x N, each row sums to 1
+
+  static Hmm train(const std::vector<Sequence>& data, const TrainOptions& options, TrainReport* report = nullptr);
+
+  nlohmann::json to_json() const;
+  static Hmm from_json(const nlohmann::json& j);  // throws ModelError naming the field
+
+  // Forward pass one frame at a time (live recognition).
+  class Stream {
+   public:
+    explicit Stream(const Hmm& model) : model_(&model) {}
+    double step(const Eigen::VectorXd& x);  // log-likelihood of all frames so far
+    const Eigen::VectorXd& log_alpha() const { return alpha_; }
+    int frames() const { return frames_; }
+    void reset() { frames_ = 0; }
+
+   private:
+    const Hmm* model_;
+    Eigen::VectorXd alpha_;
+    int frames_ = 0;
+  };
+
+ private:
+  Eigen::MatrixXd log_emissions(const Sequence& x) const;  // T x N
+  void forward(const Eigen::MatrixXd& logb, Eigen::MatrixXd& alpha) const;
+  void backward(const Eigen::MatrixXd& logb, Eigen::MatrixXd& beta) const;
+
+  int dim_ = 0;
+  Covariance covariance_ = Covariance::Full;
+  Eigen::VectorXd log_start_;
+  Eigen::MatrixXd log_trans_;
+  std::vector<GaussianMixture> emissions_;
+};
+
+double log_sum_exp(const Eigen::VectorXd& v);
+
+}  // namespace skelgraph::gesture

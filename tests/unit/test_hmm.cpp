@@ -1,0 +1,194 @@
+// The HMM core: forward and Viterbi against brute force over every path,
+// no underflow on long sequences, streaming equals batch, Baum-Welch raises
+// the likelihood and finds the generating model's states, save/load and
+// malformed models.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <random>
+
+#include <Eigen/Cholesky>
+
+#include "skelgraph/gesture/hmm.hpp"
+
+using namespace skelgraph::gesture;
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+namespace {
+
+GaussianMixture gauss(std::vector<double> mean, double sd) {
+  GaussianMixture g;
+  const auto d = static_cast<Eigen::Index>(mean.size());
+  g.weights = VectorXd::Ones(1);
+  g.means = {Eigen::Map<VectorXd>(mean.data(), d)};
+  g.covs = {MatrixXd::Identity(d, d) * sd * sd};
+  return g;
+}
+
+// Three states in 2-D, a loop 0 -> 1 -> 2 -> 0.
+Hmm three_states() {
+  Hmm h(3, 2, Covariance::Full);
+  VectorXd start(3);
+  start << 0.6, 0.3, 0.1;
+  MatrixXd a(3, 3);
+  a << 0.8, 0.15, 0.05, 0.05, 0.8, 0.15, 0.15, 0.05, 0.8;
+  auto g2 = gauss({0, 3}, 0.7);
+  g2.weights = VectorXd::Constant(2, 0.5);
+  g2.means.push_back((VectorXd(2) << 0.5, 4).finished());
+  g2.covs.push_back((MatrixXd(2, 2) << 0.4, 0.1, 0.1, 0.3).finished());
+  h.set(start, a, {gauss({0, 0}, 0.5), gauss({3, 0}, 0.5), g2});
+  return h;
+}
+
+Sequence sample(const Hmm& h, int T, std::mt19937_64& rng, std::vector<int>* states = nullptr) {
+  const VectorXd start = h.start();
+  const MatrixXd a = h.transitions();
+  const auto draw = [&](const VectorXd& p) {
+    double r = std::uniform_real_distribution<double>(0, 1)(rng);
+    for (Eigen::Index i = 0; i < p.size(); ++i) {
+      if ((r -= p(i)) <= 0) return static_cast<int>(i);
+    }
+    return static_cast<int>(p.size() - 1);
+  };
+  Sequence x(T, h.dim());
+  int s = draw(start);
+  std::normal_distribution<double> n(0, 1);
+  for (int t = 0; t < T; ++t) {
+    if (t > 0) s = draw(a.row(s).transpose());
+    if (states) states->push_back(s);
+    const auto& g = h.emissions()[static_cast<std::size_t>(s)];
+    const int m = draw(g.weights);
+    const Eigen::LLT<MatrixXd> llt(g.covs[static_cast<std::size_t>(m)]);
+    VectorXd z(h.dim());
+    for (int d = 0; d < h.dim(); ++d) z(d) = n(rng);
+    x.row(t) = (g.means[static_cast<std::size_t>(m)] + MatrixXd(llt.matrixL()) * z).transpose();
+  }
+  return x;
+}
+
+}  // namespace
+
+TEST(Hmm, ForwardAndViterbiMatchBruteForce) {
+  const Hmm h = three_states();
+  std::mt19937_64 rng(1);
+  const Sequence x = sample(h, 6, rng);
+  const VectorXd start = h.start();
+  const MatrixXd a = h.transitions();
+  double total = 0, best = -1;
+  std::vector<int> best_path, path(6);
+  std::function<void(int, double)> walk = [&](int t, double p) {
+    if (t == 6) {
+      total += p;
+      if (p > best) best = p, best_path = path;
+      return;
+    }
+    for (int s = 0; s < 3; ++s) {
+      path[static_cast<std::size_t>(t)] = s;
+      const double e = std::exp(h.emissions()[static_cast<std::size_t>(s)].log_pdf(x.row(t).transpose()));
+      walk(t + 1, p * (t == 0 ? start(s) : a(path[static_cast<std::size_t>(t - 1)], s)) * e);
+    }
+  };
+  walk(0, 1.0);
+  EXPECT_NEAR(h.log_likelihood(x), std::log(total), 1e-9);
+  double lp = 0;
+  EXPECT_EQ(h.viterbi(x, &lp), best_path);
+  EXPECT_NEAR(lp, std::log(best), 1e-9);
+  const MatrixXd post = h.posteriors(x);
+  for (Eigen::Index t = 0; t < post.rows(); ++t) EXPECT_NEAR(post.row(t).sum(), 1.0, 1e-9);
+}
+
+TEST(Hmm, LongSequencesDoNotUnderflowAndStreamingMatches) {
+  const Hmm h = three_states();
+  std::mt19937_64 rng(2);
+  const Sequence x = sample(h, 20000, rng);
+  const double ll = h.log_likelihood(x);
+  EXPECT_TRUE(std::isfinite(ll));
+  EXPECT_LT(ll, -20000);  // far below what a plain product of probabilities could hold
+  Hmm::Stream s(h);
+  double streamed = 0;
+  for (Eigen::Index t = 0; t < x.rows(); ++t) streamed = s.step(x.row(t).transpose());
+  EXPECT_NEAR(streamed, ll, 1e-6 * std::abs(ll));
+  EXPECT_EQ(h.viterbi(x).size(), 20000u);
+}
+
+TEST(Hmm, BaumWelchFindsTheGeneratingStates) {
+  const Hmm truth = three_states();
+  std::mt19937_64 rng(3);
+  std::vector<Sequence> data;
+  for (int i = 0; i < 60; ++i) data.push_back(sample(truth, 40 + 5 * (i % 7), rng));  // different lengths
+  TrainOptions o;
+  o.states = 3;
+  o.mixtures = 2;
+  TrainReport rep;
+  const Hmm h = Hmm::train(data, o, &rep);
+  ASSERT_GE(rep.log_likelihood.size(), 3u);
+  for (std::size_t i = 1; i < rep.log_likelihood.size(); ++i) {
+    EXPECT_GE(rep.log_likelihood[i], rep.log_likelihood[i - 1] - 1e-6 * std::abs(rep.log_likelihood[i - 1])) << i;
+  }
+  EXPECT_TRUE(rep.converged);
+  // Close to the generating model on fresh data (per frame).
+  double ll_truth = 0, ll_fit = 0, frames = 0;
+  for (int i = 0; i < 20; ++i) {
+    const Sequence x = sample(truth, 60, rng);
+    ll_truth += truth.log_likelihood(x);
+    ll_fit += h.log_likelihood(x);
+    frames += 60;
+  }
+  EXPECT_GT(ll_fit / frames, ll_truth / frames - 0.05);
+  // Each true state's mean is near one learnt component.
+  for (const auto& want : {VectorXd((VectorXd(2) << 0, 0).finished()), VectorXd((VectorXd(2) << 3, 0).finished())}) {
+    double best = 1e9;
+    for (const auto& g : h.emissions()) {
+      for (const auto& m : g.means) best = std::min(best, (m - want).norm());
+    }
+    EXPECT_LT(best, 0.2);
+  }
+  // Deterministic with the seed.
+  const Hmm again = Hmm::train(data, o);
+  EXPECT_DOUBLE_EQ(again.log_likelihood(data[0]), h.log_likelihood(data[0]));
+  // Diagonal covariances and a left-right topology train too.
+  o.covariance = Covariance::Diagonal;
+  o.left_right = true;
+  const Hmm lr = Hmm::train(data, o);
+  EXPECT_EQ(lr.transitions()(2, 0), 0.0);
+  EXPECT_EQ(lr.emissions()[0].covs[0](0, 1), 0.0);
+}
+
+TEST(Hmm, SaveLoadAndMalformedModels) {
+  const Hmm h = three_states();
+  const auto j = h.to_json();
+  const Hmm back = Hmm::from_json(nlohmann::json::parse(j.dump()));
+  std::mt19937_64 rng(4);
+  const Sequence x = sample(h, 50, rng);
+  EXPECT_NEAR(back.log_likelihood(x), h.log_likelihood(x), 1e-9);
+  const auto error_of = [](nlohmann::json m) {
+    try {
+      Hmm::from_json(m);
+    } catch (const ModelError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  auto bad = j;
+  bad["version"] = 7;
+  EXPECT_NE(error_of(bad).find("version 7 is not supported"), std::string::npos);
+  bad = j;
+  bad.erase("transitions");
+  EXPECT_NE(error_of(bad).find("missing 'transitions'"), std::string::npos);
+  bad = j;
+  bad["transitions"][1][0] = 0.5;
+  EXPECT_NE(error_of(bad).find("'transitions' row 1 sums to"), std::string::npos);
+  bad = j;
+  bad["emissions"][2]["covariances"][1] = {{1.0, 2.0}, {2.0, 1.0}};
+  EXPECT_NE(error_of(bad).find("not positive definite"), std::string::npos);
+  bad = j;
+  bad["format"] = "other";
+  EXPECT_NE(error_of(bad).find("not a skelgraph HMM"), std::string::npos);
+  // Training input problems are clear too.
+  TrainOptions o;
+  EXPECT_THROW(Hmm::train({}, o), ModelError);
+  EXPECT_THROW(Hmm::train({MatrixXd::Zero(5, 2), MatrixXd::Zero(5, 3)}, o), ModelError);
+  EXPECT_THROW(h.log_likelihood(MatrixXd::Zero(4, 3)), ModelError);
+}
