@@ -8,6 +8,8 @@
 #include <functional>
 #include <random>
 
+#include <unistd.h>
+
 #include <Eigen/Cholesky>
 
 #include "skelgraph/gesture/hmm.hpp"
@@ -191,4 +193,51 @@ TEST(Hmm, SaveLoadAndMalformedModels) {
   EXPECT_THROW(Hmm::train({}, o), ModelError);
   EXPECT_THROW(Hmm::train({MatrixXd::Zero(5, 2), MatrixXd::Zero(5, 3)}, o), ModelError);
   EXPECT_THROW(h.log_likelihood(MatrixXd::Zero(4, 3)), ModelError);
+}
+
+// --- Peer check: pomegranate (an independent implementation) on the same model ---
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+TEST(HmmPeer, PomegranateAgreesOnLikelihoodAndViterbi) {
+  const auto dir = std::filesystem::temp_directory_path() / ("skelgraph_hmm_peer_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  for (const auto cov : {Covariance::Full, Covariance::Diagonal}) {
+    Hmm h = three_states();
+    if (cov == Covariance::Diagonal) {
+      // The same model with diagonal covariances, trained so the numbers are not round.
+      std::mt19937_64 rng(5);
+      std::vector<Sequence> data;
+      for (int i = 0; i < 30; ++i) data.push_back(sample(h, 50, rng));
+      TrainOptions o;
+      o.states = 3;
+      o.mixtures = 2;
+      o.covariance = Covariance::Diagonal;
+      h = Hmm::train(data, o);
+    }
+    std::mt19937_64 rng(6);
+    nlohmann::json in{{"model", h.to_json()}, {"sequences", nlohmann::json::array()}};
+    std::vector<Sequence> seqs;
+    for (int T : {5, 20, 60, 200}) {
+      seqs.push_back(sample(h, T, rng));
+      nlohmann::json rows = nlohmann::json::array();
+      for (Eigen::Index t = 0; t < T; ++t) rows.push_back({seqs.back()(t, 0), seqs.back()(t, 1)});
+      in["sequences"].push_back(rows);
+    }
+    std::ofstream(dir / "in.json") << in.dump();
+    const std::string cmd = "/usr/bin/python3 " + std::string(SKELGRAPH_SOURCE_DIR) + "/tests/support/pomegranate_peer.py " +
+                            (dir / "in.json").string() + " " + (dir / "out.json").string();
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd << " (needs Debian's python3-pomegranate; tools/run installs it)";
+    const auto out = nlohmann::json::parse(std::ifstream(dir / "out.json"));
+    for (std::size_t i = 0; i < seqs.size(); ++i) {
+      const double ours = h.log_likelihood(seqs[i]), theirs = out["log_probability"][i].get<double>();
+      EXPECT_NEAR(ours, theirs, 1e-6 * std::abs(theirs)) << "sequence " << i;
+      double vlp = 0;
+      EXPECT_EQ(h.viterbi(seqs[i], &vlp), out["viterbi"][i].get<std::vector<int>>()) << "sequence " << i;
+      EXPECT_NEAR(vlp, out["viterbi_log_probability"][i].get<double>(), 1e-6 * std::abs(vlp)) << "sequence " << i;
+    }
+  }
+  std::filesystem::remove_all(dir);
 }
