@@ -15,9 +15,6 @@ using Eigen::VectorXd;
 namespace {
 constexpr double kNegInf = -std::numeric_limits<double>::infinity();
 double safe_log(double p) { return p > 0 ? std::log(p) : kNegInf; }
-// Scalar exp: Eigen's vectorised exp turns -inf into a denormal, not 0, and
-// structural zeros (a left-right model's backward transitions) must stay 0.
-double exact_exp(double v) { return std::exp(v); }
 }  // namespace
 
 double log_sum_exp(const VectorXd& v) {
@@ -55,6 +52,14 @@ void GaussianMixture::log_pdf_components(const VectorXd& x, VectorXd& out) const
   }
 }
 
+void GaussianMixture::log_pdf_components(const MatrixXd& X, Eigen::Ref<MatrixXd> out) const {
+  for (Eigen::Index k = 0; k < log_norm_.size(); ++k) {
+    const auto ku = static_cast<std::size_t>(k);
+    const MatrixXd Z = (X.rowwise() - means[ku].transpose()) * inv_l_[ku].transpose();
+    out.col(k) = (log_norm_(k) - 0.5 * Z.rowwise().squaredNorm().array()).matrix();
+  }
+}
+
 double GaussianMixture::log_pdf(const VectorXd& x) const {
   VectorXd c;
   log_pdf_components(x, c);
@@ -63,18 +68,14 @@ double GaussianMixture::log_pdf(const VectorXd& x) const {
 
 // --- The model ---
 
-Hmm::Hmm(int states, int dim, Covariance covariance)
-    : dim_(dim),
-      covariance_(covariance),
-      log_start_(VectorXd::Constant(states, -std::log(static_cast<double>(states)))),
-      log_trans_(MatrixXd::Constant(states, states, -std::log(static_cast<double>(states)))) {
-  emissions_.resize(static_cast<std::size_t>(states));
-  for (auto& e : emissions_) {
+Hmm::Hmm(int states, int dim, Covariance covariance) : dim_(dim), covariance_(covariance) {
+  std::vector<GaussianMixture> em(static_cast<std::size_t>(states));
+  for (auto& e : em) {
     e.weights = VectorXd::Ones(1);
     e.means = {VectorXd::Zero(dim)};
     e.covs = {MatrixXd::Identity(dim, dim)};
-    e.prepare();
   }
+  set(VectorXd::Constant(states, 1.0 / states), MatrixXd::Constant(states, states, 1.0 / states), std::move(em));
 }
 
 void Hmm::set(const VectorXd& start, const MatrixXd& transitions, std::vector<GaussianMixture> emissions) {
@@ -101,58 +102,87 @@ void Hmm::set(const VectorXd& start, const MatrixXd& transitions, std::vector<Ga
   }
   log_start_ = start.unaryExpr(&safe_log);
   log_trans_ = transitions.unaryExpr(&safe_log);
+  start_ = start;
+  trans_ = transitions;
   emissions_ = std::move(emissions);
+  offsets_.clear();
+  Eigen::Index off = 0;
+  for (const auto& e : emissions_) {
+    offsets_.push_back(off);
+    off += e.weights.size();
+  }
+  offsets_.push_back(off);
 }
 
-VectorXd Hmm::start() const { return log_start_.unaryExpr(&exact_exp); }
-MatrixXd Hmm::transitions() const { return log_trans_.unaryExpr(&exact_exp); }
+VectorXd Hmm::start() const { return start_; }
+MatrixXd Hmm::transitions() const { return trans_; }
 
 MatrixXd Hmm::log_emissions(const Sequence& x) const {
   if (x.cols() != dim_) throw ModelError("sequence has " + std::to_string(x.cols()) + " features per frame, the model " + std::to_string(dim_));
-  MatrixXd b(x.rows(), states());
-  for (Eigen::Index t = 0; t < x.rows(); ++t) {
-    const VectorXd xt = x.row(t).transpose();
-    for (int j = 0; j < states(); ++j) b(t, j) = emissions_[static_cast<std::size_t>(j)].log_pdf(xt);
+  MatrixXd comp(x.rows(), offsets_.back()), b(x.rows(), states());
+  for (int j = 0; j < states(); ++j) {
+    const auto off = offsets_[static_cast<std::size_t>(j)], m = offsets_[static_cast<std::size_t>(j) + 1] - off;
+    emissions_[static_cast<std::size_t>(j)].log_pdf_components(x, comp.middleCols(off, m));
+    for (Eigen::Index t = 0; t < x.rows(); ++t) b(t, j) = log_sum_exp(comp.row(t).segment(off, m).transpose());
   }
   return b;
 }
 
-void Hmm::forward(const MatrixXd& logb, MatrixXd& alpha) const {
-  const auto T = logb.rows();
+Hmm::Pass Hmm::pass(const Sequence& x, bool with_backward) const {
+  if (x.cols() != dim_) throw ModelError("sequence has " + std::to_string(x.cols()) + " features per frame, the model " + std::to_string(dim_));
+  Pass p;
+  const auto T = x.rows();
   const int N = states();
-  alpha.resize(T, N);
-  if (T == 0) return;
-  alpha.row(0) = (log_start_ + logb.row(0).transpose()).transpose();
-  VectorXd tmp(N);
-  for (Eigen::Index t = 1; t < T; ++t) {
-    for (int j = 0; j < N; ++j) {
-      tmp = alpha.row(t - 1).transpose() + log_trans_.col(j);
-      alpha(t, j) = log_sum_exp(tmp) + logb(t, j);
+  p.comp.resize(T, offsets_.back());
+  p.logb.resize(T, N);
+  for (int j = 0; j < N; ++j) {
+    const auto off = offsets_[static_cast<std::size_t>(j)], m = offsets_[static_cast<std::size_t>(j) + 1] - off;
+    emissions_[static_cast<std::size_t>(j)].log_pdf_components(x, p.comp.middleCols(off, m));
+    if (m == 1) {
+      p.logb.col(j) = p.comp.col(off);
+    } else {
+      const VectorXd mx = p.comp.middleCols(off, m).rowwise().maxCoeff();
+      p.logb.col(j) = mx.array() + ((p.comp.middleCols(off, m).colwise() - mx).array().exp().rowwise().sum()).log();
     }
   }
-}
-
-void Hmm::backward(const MatrixXd& logb, MatrixXd& beta) const {
-  const auto T = logb.rows();
-  const int N = states();
-  beta.resize(T, N);
-  if (T == 0) return;
-  beta.row(T - 1).setZero();
-  VectorXd tmp(N);
-  for (Eigen::Index t = T - 2; t >= 0; --t) {
-    const VectorXd next = logb.row(t + 1).transpose() + beta.row(t + 1).transpose();
-    for (int i = 0; i < N; ++i) {
-      tmp = log_trans_.row(i).transpose() + next;
-      beta(t, i) = log_sum_exp(tmp);
+  const VectorXd rowmax = p.logb.rowwise().maxCoeff();
+  p.B = (p.logb.colwise() - rowmax).array().exp().matrix();
+  p.alpha.resize(T, N);
+  p.scale.resize(T);
+  p.log_likelihood = 0;
+  Eigen::RowVectorXd prior(N);
+  for (Eigen::Index t = 0; t < T; ++t) {
+    if (!std::isfinite(rowmax(t))) {
+      p.log_likelihood = kNegInf;  // no state can emit this frame
+      return p;
+    }
+    if (t == 0) prior = start_.transpose();
+    else prior.noalias() = p.alpha.row(t - 1) * trans_;
+    p.alpha.row(t) = prior.cwiseProduct(p.B.row(t));
+    p.scale(t) = p.alpha.row(t).sum();
+    if (!(p.scale(t) > 0)) {
+      p.log_likelihood = kNegInf;
+      return p;
+    }
+    p.alpha.row(t) /= p.scale(t);
+    p.log_likelihood += std::log(p.scale(t)) + rowmax(t);
+  }
+  if (with_backward) {
+    p.beta.resize(T, N);
+    p.beta.row(T - 1).setOnes();
+    VectorXd v(N), w(N);
+    for (Eigen::Index t = T - 2; t >= 0; --t) {
+      v = p.B.row(t + 1).cwiseProduct(p.beta.row(t + 1)).transpose();
+      w.noalias() = trans_ * v;
+      p.beta.row(t) = w.transpose() / p.scale(t + 1);
     }
   }
+  return p;
 }
 
 double Hmm::log_likelihood(const Sequence& x) const {
   if (x.rows() == 0) return 0.0;
-  MatrixXd alpha;
-  forward(log_emissions(x), alpha);
-  return log_sum_exp(alpha.row(x.rows() - 1).transpose());
+  return pass(x, false).log_likelihood;
 }
 
 std::vector<int> Hmm::viterbi(const Sequence& x, double* log_prob) const {
@@ -184,15 +214,10 @@ std::vector<int> Hmm::viterbi(const Sequence& x, double* log_prob) const {
 }
 
 MatrixXd Hmm::posteriors(const Sequence& x) const {
-  const MatrixXd logb = log_emissions(x);
-  MatrixXd alpha, beta;
-  forward(logb, alpha);
-  backward(logb, beta);
-  MatrixXd g = alpha + beta;
-  for (Eigen::Index t = 0; t < g.rows(); ++t) {
-    const double z = log_sum_exp(g.row(t).transpose());
-    g.row(t) = (g.row(t).array() - z).matrix().unaryExpr(&exact_exp);
-  }
+  const Pass p = pass(x, true);
+  if (!std::isfinite(p.log_likelihood)) throw ModelError("posteriors: the sequence is impossible under the model");
+  MatrixXd g = p.alpha.cwiseProduct(p.beta);
+  for (Eigen::Index t = 0; t < g.rows(); ++t) g.row(t) /= g.row(t).sum();
   return g;
 }
 
@@ -372,40 +397,30 @@ Hmm Hmm::train(const std::vector<Sequence>& data, const TrainOptions& o, TrainRe
     std::vector<std::vector<VectorXd>> x_acc(static_cast<std::size_t>(N), std::vector<VectorXd>(static_cast<std::size_t>(M), VectorXd::Zero(D)));
     std::vector<std::vector<MatrixXd>> xx_acc(static_cast<std::size_t>(N), std::vector<MatrixXd>(static_cast<std::size_t>(M), MatrixXd::Zero(D, D)));
     double total = 0;
-    VectorXd comps;
     for (const auto& x : data) {
       const auto T = x.rows();
-      const MatrixXd logb = h.log_emissions(x);
-      MatrixXd alpha, beta;
-      h.forward(logb, alpha);
-      h.backward(logb, beta);
-      const double lp = log_sum_exp(alpha.row(T - 1).transpose());
-      if (!std::isfinite(lp)) throw ModelError("training: a sequence has zero likelihood under the model (a left-right model shorter than it needs?)");
-      total += lp;
-      const MatrixXd gamma = (alpha + beta).array() - lp;
-      start_acc += gamma.row(0).transpose().unaryExpr(&exact_exp);
-      for (Eigen::Index t = 0; t + 1 < T; ++t) {
-        const VectorXd next = logb.row(t + 1).transpose() + beta.row(t + 1).transpose();
-        for (int i = 0; i < N; ++i) {
-          if (alpha(t, i) == kNegInf) continue;
-          trans_acc.row(i) += ((alpha(t, i) - lp) + h.log_trans_.row(i).transpose().array() + next.array()).matrix().unaryExpr(&exact_exp).transpose();
-        }
+      const Pass p = h.pass(x, true);
+      if (!std::isfinite(p.log_likelihood)) {
+        throw ModelError("training: a sequence has zero likelihood under the model (a left-right model shorter than it needs?)");
       }
-      for (Eigen::Index t = 0; t < T; ++t) {
-        const VectorXd xt = x.row(t).transpose();
-        const MatrixXd outer = xt * xt.transpose();
-        for (int j = 0; j < N; ++j) {
-          const double gj = gamma(t, j);
-          if (gj < -50) continue;  // below 2e-22: no weight to speak of
-          h.emissions_[static_cast<std::size_t>(j)].log_pdf_components(xt, comps);
-          const double lb = logb(t, j);
-          for (int m = 0; m < M; ++m) {
-            const double r = std::exp(gj + comps(m) - lb);
-            if (r <= 0) continue;
-            n_acc[static_cast<std::size_t>(j)](m) += r;
-            x_acc[static_cast<std::size_t>(j)][static_cast<std::size_t>(m)] += r * xt;
-            xx_acc[static_cast<std::size_t>(j)][static_cast<std::size_t>(m)] += r * outer;
-          }
+      total += p.log_likelihood;
+      const MatrixXd gamma = p.alpha.cwiseProduct(p.beta);  // rows sum to 1
+      start_acc += gamma.row(0).transpose();
+      if (T > 1) {
+        // xi summed over time: A .* (alpha[0..T-2]^T * (B .* beta)[1..T-1] / c)
+        const MatrixXd W = (p.B.bottomRows(T - 1).cwiseProduct(p.beta.bottomRows(T - 1))).array().colwise() /
+                           p.scale.tail(T - 1).array();
+        trans_acc += h.trans_.cwiseProduct(p.alpha.topRows(T - 1).transpose() * W);
+      }
+      for (int j = 0; j < N; ++j) {
+        const auto off = h.offsets_[static_cast<std::size_t>(j)];
+        for (int m = 0; m < M; ++m) {
+          const VectorXd r = gamma.col(j).cwiseProduct((p.comp.col(off + m) - p.logb.col(j)).array().exp().matrix());
+          n_acc[static_cast<std::size_t>(j)](m) += r.sum();
+          x_acc[static_cast<std::size_t>(j)][static_cast<std::size_t>(m)] += x.transpose() * r;
+          // sum_t r_t x_t x_t^T as a symmetric rank-k update (half the work of a full product).
+          const MatrixXd xs = (x.array().colwise() * r.array().sqrt()).matrix();
+          xx_acc[static_cast<std::size_t>(j)][static_cast<std::size_t>(m)].selfadjointView<Eigen::Lower>().rankUpdate(xs.transpose());
         }
       }
     }
@@ -443,7 +458,8 @@ Hmm Hmm::train(const std::vector<Sequence>& data, const TrainOptions& o, TrainRe
           continue;
         }
         const VectorXd mu = x_acc[static_cast<std::size_t>(j)][static_cast<std::size_t>(m)] / n;
-        const MatrixXd cov = xx_acc[static_cast<std::size_t>(j)][static_cast<std::size_t>(m)] / n - mu * mu.transpose();
+        const MatrixXd xx = xx_acc[static_cast<std::size_t>(j)][static_cast<std::size_t>(m)].selfadjointView<Eigen::Lower>();
+        const MatrixXd cov = xx / n - mu * mu.transpose();
         g.means.push_back(mu);
         g.covs.push_back(shape(cov, o.covariance, reg));
         g.weights(m) = n;

@@ -34,6 +34,8 @@ struct GaussianMixture {
   void prepare();
   double log_pdf(const Eigen::VectorXd& x) const;                      // log sum_m w_m N(x; mu_m, S_m)
   void log_pdf_components(const Eigen::VectorXd& x, Eigen::VectorXd& out) const;  // log w_m + log N_m
+  // log w_m + log N_m(x_t) for every frame (row) of X at once: out is T x M.
+  void log_pdf_components(const Eigen::MatrixXd& X, Eigen::Ref<Eigen::MatrixXd> out) const;
 
  private:
   std::vector<Eigen::MatrixXd> inv_l_;  // L^-1 with S = L L^T
@@ -97,15 +99,28 @@ class Hmm {
     int frames_ = 0;
   };
 
+  // Forward and backward in scaled probabilities (each frame's emissions
+  // scaled by their largest, alpha normalised every frame): no exp or log per
+  // cell, matrix products instead, and no underflow on any length.
+  struct Pass {
+    Eigen::MatrixXd comp;    // T x (sum of M): log w_m + log N_m per state's components
+    Eigen::MatrixXd logb;    // T x N
+    using Rows = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;  // a frame is contiguous
+    Rows B;                  // T x N, exp(logb - rowmax)
+    Rows alpha, beta;        // scaled: rows of alpha sum to 1; alpha .* beta = posteriors
+    Eigen::VectorXd scale;   // c_t
+    double log_likelihood = 0;
+  };
+  Pass pass(const Sequence& x, bool with_backward) const;
+
  private:
   Eigen::MatrixXd log_emissions(const Sequence& x) const;  // T x N
-  void forward(const Eigen::MatrixXd& logb, Eigen::MatrixXd& alpha) const;
-  void backward(const Eigen::MatrixXd& logb, Eigen::MatrixXd& beta) const;
+  std::vector<Eigen::Index> offsets_;  // first column of each state's components in Pass::comp
 
   int dim_ = 0;
   Covariance covariance_ = Covariance::Full;
-  Eigen::VectorXd log_start_;
-  Eigen::MatrixXd log_trans_;
+  Eigen::VectorXd log_start_, start_;
+  Eigen::MatrixXd log_trans_, trans_;
   std::vector<GaussianMixture> emissions_;
 };
 
