@@ -84,6 +84,28 @@ nlohmann::json pose_json(const Eigen::Isometry3d& T) {
 double cm(double m) { return std::isfinite(m) ? std::round(m * 1000.0) / 10.0 : m; }
 nlohmann::json num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
 
+// The reference sensor's pose in the world: from a calibration file, or the
+// identity (the reference's frame is the world) without one.
+Eigen::Isometry3d reference_in_world(const std::string& file, const std::string& ref) {
+  if (file.empty()) return Eigen::Isometry3d::Identity();
+  try {
+    for (const auto& p : calib::read_calib_file(file).sensors) {
+      if (p.sensor_id == ref) return p.pose;
+    }
+  } catch (const calib::CalibFileError& e) {
+    throw UsageError(e.what());
+  }
+  throw UsageError(file + ": has no pose of the reference sensor '" + ref + "'");
+}
+
+void write_calib(const std::string& out, const calib::CalibFile& f) {
+  try {
+    calib::write_calib_file(out, f);
+  } catch (const calib::CalibFileError& e) {
+    throw UsageError(e.what());
+  }
+}
+
 // One input: fit (on the first half with --holdout), check, and the verdict.
 nlohmann::json calibrate_one(const std::string& path, const SkelOptions& o, skeleton::SensorPose* result) {
   const Input in = read_input(path, o.format);
@@ -188,18 +210,7 @@ int calib_skeleton(const SkelOptions& o) {
     }
     if (!o.out.empty()) {
       // world = the reference sensor's frame, unless --ref-pose places the reference in a world.
-      Eigen::Isometry3d world_from_ref = Eigen::Isometry3d::Identity();
-      if (!o.ref_pose.empty()) {
-        bool found = false;
-        try {
-          for (const auto& p : calib::read_calib_file(o.ref_pose).sensors) {
-            if (p.sensor_id == o.ref) world_from_ref = p.pose, found = true;
-          }
-        } catch (const calib::CalibFileError& e) {
-          throw UsageError(e.what());
-        }
-        if (!found) throw UsageError(o.ref_pose + ": has no pose of the reference sensor '" + o.ref + "'");
-      }
+      const Eigen::Isometry3d world_from_ref = reference_in_world(o.ref_pose, o.ref);
       calib::CalibFile f;
       f.comment = "written by skelgraph calib skeleton " + path + " --ref " + o.ref;
       skeleton::SensorPose ref;
@@ -208,11 +219,7 @@ int calib_skeleton(const SkelOptions& o) {
       ref.method = o.ref_pose.empty() ? "reference" : "from " + o.ref_pose;
       pose.pose = world_from_ref * pose.pose;
       f.sensors = {ref, pose};
-      try {
-        calib::write_calib_file(o.out, f);
-      } catch (const calib::CalibFileError& e) {
-        throw UsageError(e.what());
-      }
+      write_calib(o.out, f);
       j["written"] = o.out;
     }
     if (!o.json) {
@@ -461,27 +468,11 @@ int calib_board(const BoardOptions& o) {
     p.rms_residual_m = r.fit.rms;
     p.max_residual_m = r.fit.max;
     f.sensors = {p};
-    try {
-      calib::write_calib_file(o.out, f);
-    } catch (const calib::CalibFileError& e) {
-      throw UsageError(e.what());
-    }
+    write_calib(o.out, f);
     j["written"] = o.out;
   } else if (!o.out.empty()) {
-    Eigen::Isometry3d world_from_ref = Eigen::Isometry3d::Identity();
-    std::string ref_method = "reference";
-    if (!o.ref_pose.empty()) {
-      bool found = false;
-      try {
-        for (const auto& p : calib::read_calib_file(o.ref_pose).sensors) {
-          if (p.sensor_id == o.ref) world_from_ref = p.pose, found = true;
-        }
-      } catch (const calib::CalibFileError& e) {
-        throw UsageError(e.what());
-      }
-      if (!found) throw UsageError(o.ref_pose + ": has no pose of the reference sensor '" + o.ref + "'");
-      ref_method = "from " + o.ref_pose;
-    }
+    const Eigen::Isometry3d world_from_ref = reference_in_world(o.ref_pose, o.ref);
+    const std::string ref_method = o.ref_pose.empty() ? "reference" : "from " + o.ref_pose;
     calib::CalibFile f;
     f.comment = "written by skelgraph calib board " + o.ref_dir + " " + o.other_dir;
     skeleton::SensorPose pr, po;
@@ -494,11 +485,7 @@ int calib_board(const BoardOptions& o) {
     po.rms_residual_m = r.fit.rms;
     po.max_residual_m = r.fit.max;
     f.sensors = {pr, po};
-    try {
-      calib::write_calib_file(o.out, f);
-    } catch (const calib::CalibFileError& e) {
-      throw UsageError(e.what());
-    }
+    write_calib(o.out, f);
     j["written"] = o.out;
   }
   if (o.json) {

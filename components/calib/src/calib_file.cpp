@@ -34,17 +34,21 @@ std::vector<double> numbers(const std::string& path, const YAML::Node& n, const 
   return out;
 }
 
-}  // namespace
-
-CalibFile read_calib_file(const std::string& path) {
-  YAML::Node root;
+// The file parsed, or CalibFileError naming file:line:column.
+YAML::Node load(const std::string& path) {
   try {
-    root = YAML::LoadFile(path);
+    return YAML::LoadFile(path);
   } catch (const YAML::BadFile&) {
     throw CalibFileError(path + ": cannot read the file");
   } catch (const YAML::ParserException& e) {
     throw CalibFileError(path + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) + ": " + e.msg);
   }
+}
+
+}  // namespace
+
+CalibFile read_calib_file(const std::string& path) {
+  const YAML::Node root = load(path);
   if (!root.IsMap()) fail(path, root, "expected a mapping with 'version', 'frame_id' and 'sensors'");
   if (!root["version"] || root["version"].as<std::string>("") != "1") {
     fail(path, root["version"] ? root["version"] : root, "expected 'version: 1'");
@@ -120,14 +124,7 @@ std::vector<Eigen::Vector3d> points(const std::string& path, const YAML::Node& p
 }  // namespace
 
 BoardMarkers read_board_markers(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw CalibFileError(path + ": cannot read the file");
-  } catch (const YAML::ParserException& e) {
-    throw CalibFileError(path + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) + ": " + e.msg);
-  }
+  const YAML::Node root = load(path);
   if (!root.IsMap() || !root["version"] || root["version"].as<std::string>("") != "1") {
     fail(path, root, "expected a board markers file with 'version: 1'");
   }
@@ -171,14 +168,7 @@ void write_board_markers(const std::string& path, const BoardMarkers& m, const s
 }
 
 Intrinsics read_intrinsics_file(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw CalibFileError(path + ": cannot read the file");
-  } catch (const YAML::ParserException& e) {
-    throw CalibFileError(path + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) + ": " + e.msg);
-  }
+  const YAML::Node root = load(path);
   if (!root.IsMap() || !root["version"] || root["version"].as<std::string>("") != "1") {
     fail(path, root, "expected an intrinsics file with 'version: 1'");
   }
