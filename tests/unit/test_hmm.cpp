@@ -241,3 +241,67 @@ TEST(HmmPeer, PomegranateAgreesOnLikelihoodAndViterbi) {
   }
   std::filesystem::remove_all(dir);
 }
+
+// --- Arm features ---
+
+#include "skelgraph/gesture/features.hpp"
+
+namespace {
+using skelgraph::skeleton::JointId;
+using skelgraph::skeleton::Skeleton;
+
+// Shoulders at y 1.4, the right arm's elbow and hand where given, left arm hanging.
+Skeleton pose(const Eigen::Vector3d& r_elbow, const Eigen::Vector3d& r_hand, std::int64_t t_ns) {
+  Skeleton s;
+  s.stamp_ns = t_ns;
+  for (auto& j : s.joints) j.confidence = skelgraph::skeleton::kTracked;
+  s[JointId::LeftShoulder].position = {0.2, 1.4, 2};
+  s[JointId::LeftElbow].position = {0.2, 1.1, 2};
+  s[JointId::LeftHand].position = {0.2, 0.8, 2};
+  s[JointId::RightShoulder].position = {-0.2, 1.4, 2};
+  s[JointId::RightElbow].position = r_elbow;
+  s[JointId::RightHand].position = r_hand;
+  return s;
+}
+}  // namespace
+
+TEST(Features, AnglesToTheVerticalAndSpeedsOverTheRealInterval) {
+  EXPECT_EQ(feature_names(FeatureSet::Thesis8).size(), 8u);
+  EXPECT_EQ(feature_names(FeatureSet::Extended).size(), 16u);
+  EXPECT_EQ(feature_names(FeatureSet::Thesis8)[2], "right_upper_arm_angle");
+  FeatureStream fs;
+  // Right arm pointing straight forward (horizontal), left arm hanging.
+  auto x = fs.step(pose({-0.2, 1.4, 1.7}, {-0.2, 1.4, 1.4}, 0));
+  EXPECT_NEAR(x(0), M_PI, 1e-9);      // left upper arm down
+  EXPECT_NEAR(x(1), M_PI, 1e-9);      // left forearm down
+  EXPECT_NEAR(x(2), M_PI / 2, 1e-9);  // right upper arm horizontal
+  EXPECT_NEAR(x(3), M_PI / 2, 1e-9);
+  EXPECT_EQ(x.tail(4), Eigen::VectorXd::Zero(4));  // no speed on the first frame
+  // 50 ms later the right forearm points 0.1 rad higher: 2 rad/s.
+  const Eigen::Vector3d e(-0.2, 1.4, 1.7);
+  x = fs.step(pose(e, e + 0.3 * Eigen::Vector3d(0, std::sin(0.1), -std::cos(0.1)), 50'000'000));
+  EXPECT_NEAR(x(3), M_PI / 2 - 0.1, 1e-9);
+  EXPECT_NEAR(x(7), 2.0, 1e-6);
+  EXPECT_NEAR(x(6), 0.0, 1e-9);
+}
+
+TEST(Features, MissingJointsAreHeldAndMarked) {
+  const Eigen::Vector3d e(-0.2, 1.4, 1.7), h(-0.2, 1.4, 1.4);
+  std::vector<Skeleton> clip{pose(e, h, 0), pose(e, h, 33'000'000), pose(e, h, 66'000'000)};
+  clip[0][JointId::RightHand].confidence = skelgraph::skeleton::kInferred;  // before the first good value
+  clip[2][JointId::RightHand].confidence = skelgraph::skeleton::kInferred;  // after
+  clip[2][JointId::RightHand].position = {5, 5, 5};                         // ignored
+  const auto f = features_of(clip);
+  EXPECT_EQ(f.complete, (std::vector<bool>{false, true, false}));
+  EXPECT_NEAR(f.x(0, 3), M_PI / 2, 1e-9);  // took the first good value
+  EXPECT_NEAR(f.x(2, 3), M_PI / 2, 1e-9);  // held
+  EXPECT_EQ(f.x(2, 7), 0.0);               // a held angle does not move
+  // Extended: elbow bend 0 (straight arm), hand at shoulder height.
+  FeatureOptions o;
+  o.set = FeatureSet::Extended;
+  const auto g = features_of({pose(e, h, 0)}, o);
+  EXPECT_EQ(g.x.cols(), 16);
+  EXPECT_NEAR(g.x(0, 6), 0.0, 1e-6);   // right elbow bend
+  EXPECT_NEAR(g.x(0, 7), 0.0, 1e-9);   // right hand height in upper-arm lengths
+  EXPECT_NEAR(g.x(0, 5), -2.0, 1e-9);  // left hand 0.6 m below the shoulder, upper arm 0.3 m
+}
