@@ -255,23 +255,42 @@ eval::OfflineOptions offline_options(const FileOptions& o, const RecordingInputs
 
 // skelgraph eval FILE: single sensors and every method, against the truth in the
 // recording if it has one; bone-length steadiness and completeness either way.
-int eval_file(const FileOptions& o) {
-  const auto in = read_recording(o.file, o.shared_frame, o.calibration);
-  auto eo = offline_options(o, in);
-  eo.trace = !o.report_dir.empty();
-  const auto r = eval::evaluate(in.poses, in.events, eo);
+// A recording scored (with traces for plots when asked) and its summary as JSON.
+struct ScoredRecording {
+  RecordingInputs in;
+  eval::OfflineResult result;
+  nlohmann::json summary;
+};
+ScoredRecording score_recording(const FileOptions& o, bool trace) {
+  ScoredRecording s{read_recording(o.file, o.shared_frame, o.calibration), {}, {}};
+  auto eo = offline_options(o, s.in);
+  eo.trace = trace;
+  s.result = eval::evaluate(s.in.poses, s.in.events, eo);
   nlohmann::json streams = nlohmann::json::array();
-  for (const auto& s : r.streams) streams.push_back(stream_json(s));
+  for (const auto& st : s.result.streams) streams.push_back(stream_json(st));
+  s.summary = {{"file", o.file},
+               {"has_truth", s.result.has_truth},
+               {"ticks", s.result.ticks},
+               {"on_sync_ticks", !s.in.ticks.empty()},
+               {"raw_skeletons", s.in.raw},
+               {"truth_skeletons", s.in.truth},
+               {"live_fused_skeletons", s.in.fused},
+               {"streams", streams}};
+  return s;
+}
+
+int eval_file(const FileOptions& o) {
+  const auto scored = score_recording(o, !o.report_dir.empty());
+  const auto& in = scored.in;
+  const auto& r = scored.result;
   std::string report_path;
-  if (eo.trace) {
+  if (!o.report_dir.empty()) {
     std::filesystem::create_directories(o.report_dir);
     const auto name = std::filesystem::path(o.file).stem().string();
     report_path = write_report_page(o.report_dir, "skelgraph: " + name,
                                     report_section(o.report_dir, name, name, r, "right_hand"));
   }
-  nlohmann::json j{{"file", o.file},  {"has_truth", r.has_truth}, {"ticks", r.ticks},
-                   {"on_sync_ticks", !in.ticks.empty()}, {"raw_skeletons", in.raw},
-                   {"truth_skeletons", in.truth}, {"live_fused_skeletons", in.fused}, {"streams", streams}};
+  nlohmann::json j = scored.summary;
   if (!report_path.empty()) j["report"] = report_path;
   if (o.json) {
     std::printf("%s\n", j.dump(2).c_str());
@@ -353,17 +372,9 @@ int fuse_file(const FileOptions& o) {
 RecordingReport eval_recording_section(const std::string& file, const std::string& report_dir, const std::string& title) {
   FileOptions o;
   o.file = file;
-  const auto in = read_recording(file, false);
-  auto eo = offline_options(o, in);
-  eo.trace = true;
-  const auto r = eval::evaluate(in.poses, in.events, eo);
-  RecordingReport out;
-  out.summary = {{"file", file}, {"ticks", r.ticks}, {"on_sync_ticks", !in.ticks.empty()}, {"raw_skeletons", in.raw},
-                 {"truth_skeletons", in.truth}, {"live_fused_skeletons", in.fused}, {"streams", nlohmann::json::array()}};
-  for (const auto& s : r.streams) out.summary["streams"].push_back(stream_json(s));
+  const auto scored = score_recording(o, true);
   std::filesystem::create_directories(report_dir);
-  out.html = report_section(report_dir, "live", title, r, "right_hand");
-  return out;
+  return {scored.summary, report_section(report_dir, "live", title, scored.result, "right_hand")};
 }
 
 int eval_sim(const SimEvalOptions& o) {

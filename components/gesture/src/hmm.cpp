@@ -447,14 +447,12 @@ Hmm Hmm::train(const std::vector<Sequence>& data, const TrainOptions& o, TrainRe
       g.weights = VectorXd::Zero(M);
       for (int m = 0; m < M; ++m) {
         const double n = nj(m);
-        const auto& old = h.emissions_[static_cast<std::size_t>(j)];
         if (n < 1e-6) {
           // A component nothing belongs to: start it again on a random frame.
           const auto& x = data[std::uniform_int_distribution<std::size_t>(0, data.size() - 1)(rng)];
           g.means.push_back(x.row(std::uniform_int_distribution<Eigen::Index>(0, x.rows() - 1)(rng)).transpose());
           g.covs.push_back(shape(global_cov, o.covariance, reg));
           g.weights(m) = 1e-3;
-          (void)old;
           continue;
         }
         const VectorXd mu = x_acc[static_cast<std::size_t>(j)][static_cast<std::size_t>(m)] / n;
