@@ -56,5 +56,6 @@ void add_bag_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_eval_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_fuse_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_calib_command(CLI::App& app, GlobalOptions& g, Action& run);
+void add_gesture_command(CLI::App& app, GlobalOptions& g, Action& run);
 
 }  // namespace skelgraph::cli

@@ -113,6 +113,7 @@ int main(int argc, char** argv) {
   add_bag_command(app, g, run);
   add_eval_command(app, g, run);
   add_calib_command(app, g, run);
+  add_gesture_command(app, g, run);
   add_fuse_command(app, g, run);
   try {
     app.parse(argc, argv);

@@ -16,6 +16,7 @@ struct Arm {
 };
 constexpr Arm kArms[2] = {{JointId::LeftShoulder, JointId::LeftElbow, JointId::LeftHand},
                           {JointId::RightShoulder, JointId::RightElbow, JointId::RightHand}};
+constexpr const char* kSide[2] = {"left", "right"};
 
 double to_vertical(const Vector3d& v) {
   const double n = v.norm();
@@ -23,53 +24,80 @@ double to_vertical(const Vector3d& v) {
   return std::acos(std::clamp(v.y() / n, -1.0, 1.0));
 }
 
-int angle_count(FeatureSet s) { return s == FeatureSet::Thesis8 ? 4 : 8; }
+// The values of a set (before speeds), and which of them get a speed.
+struct Layout {
+  std::vector<std::string> values;
+  int speeds = 0;        // the first `speeds` values get a speed
+  bool signed_speed = false;
+};
 
-}  // namespace
-
-std::vector<std::string> feature_names(FeatureSet set) {
-  std::vector<std::string> angles;
-  for (const char* side : {"left", "right"}) {
-    angles.push_back(std::string(side) + "_upper_arm_angle");
-    angles.push_back(std::string(side) + "_forearm_angle");
+Layout layout(FeatureSet s) {
+  Layout l;
+  if (s == FeatureSet::Body) {
+    // Hands (with speeds), then knees (with speeds), then elbows.
+    for (const char* side : kSide)
+      for (const char* axis : {"out", "up", "forward"}) l.values.push_back(std::string(side) + "_hand_" + axis);
+    for (const char* side : kSide) l.values.push_back(std::string(side) + "_knee_up");
+    l.speeds = static_cast<int>(l.values.size());
+    for (const char* side : kSide)
+      for (const char* axis : {"out", "up", "forward"}) l.values.push_back(std::string(side) + "_elbow_" + axis);
+    l.signed_speed = true;
+    return l;
   }
-  if (set == FeatureSet::Extended) {
-    for (const char* side : {"left", "right"}) {
-      angles.push_back(std::string(side) + "_elbow_bend");
-      angles.push_back(std::string(side) + "_hand_height");
+  for (const char* side : kSide) {
+    l.values.push_back(std::string(side) + "_upper_arm_angle");
+    l.values.push_back(std::string(side) + "_forearm_angle");
+  }
+  if (s == FeatureSet::Extended) {
+    for (const char* side : kSide) {
+      l.values.push_back(std::string(side) + "_elbow_bend");
+      l.values.push_back(std::string(side) + "_hand_height");
     }
   }
-  std::vector<std::string> out = angles;
-  for (const auto& a : angles) out.push_back(a + "_speed");
-  return out;
+  l.speeds = static_cast<int>(l.values.size());
+  return l;
 }
 
-std::optional<FeatureSet> feature_set_from_name(const std::string& name) {
-  if (name == "thesis8") return FeatureSet::Thesis8;
-  if (name == "extended") return FeatureSet::Extended;
-  return std::nullopt;
-}
-
-FeatureStream::FeatureStream(FeatureOptions options) : o_(options), angles_(angle_count(options.set)) { reset(); }
-
-void FeatureStream::reset() {
-  last_good_ = VectorXd::Zero(angles_);
-  have_.assign(static_cast<std::size_t>(angles_), false);
-  first_ = true;
-  last_dt_ = 1.0 / 30;
-}
-
-int FeatureStream::size() const { return 2 * angles_; }
-
-VectorXd FeatureStream::step(const skeleton::Skeleton& s, bool* complete) {
-  const auto good = [&](JointId j) { return s[j].confidence >= o_.min_confidence && s[j].position.allFinite(); };
-  VectorXd a = VectorXd::Constant(angles_, std::nan(""));
+// The raw values of one frame, NaN where a joint they need is not good.
+VectorXd frame_values(FeatureSet set, const skeleton::Skeleton& s, float min_confidence, int n) {
+  const auto good = [&](JointId j) { return s[j].confidence >= min_confidence && s[j].position.allFinite(); };
+  VectorXd a = VectorXd::Constant(n, std::nan(""));
+  if (set == FeatureSet::Body) {
+    if (!good(JointId::LeftShoulder) || !good(JointId::RightShoulder)) return a;
+    const Vector3d up(0, 1, 0);
+    Vector3d across = s[JointId::RightShoulder].position - s[JointId::LeftShoulder].position;
+    across.y() = 0;
+    if (across.norm() < 1e-6) return a;
+    across.normalize();
+    const Vector3d forward = up.cross(across);
+    for (int side = 0; side < 2; ++side) {
+      const Arm& arm = kArms[side];
+      if (!good(arm.elbow) || !good(arm.hand)) continue;
+      const Vector3d sh = s[arm.shoulder].position, el = s[arm.elbow].position, ha = s[arm.hand].position;
+      const double len = (el - sh).norm() + (ha - el).norm();
+      if (len < 1e-6) continue;
+      const Vector3d out = side == 0 ? Vector3d(-across) : across;
+      const auto body = [&](const Vector3d& v) -> Vector3d { return Vector3d(v.dot(out), v.dot(up), v.dot(forward)) / len; };
+      a.segment<3>(3 * side) = body(ha - sh);
+      a.segment<3>(8 + 3 * side) = body(el - sh);
+    }
+    constexpr JointId kLegs[2][3] = {{JointId::LeftHip, JointId::LeftKnee, JointId::LeftFoot},
+                                     {JointId::RightHip, JointId::RightKnee, JointId::RightFoot}};
+    for (int side = 0; side < 2; ++side) {
+      const auto& leg = kLegs[side];
+      if (!good(leg[0]) || !good(leg[1]) || !good(leg[2])) continue;
+      const Vector3d hip = s[leg[0]].position, knee = s[leg[1]].position, foot = s[leg[2]].position;
+      const double len = (knee - hip).norm() + (foot - knee).norm();
+      if (len > 1e-6) a(6 + side) = (knee.y() - hip.y()) / len;
+    }
+    return a;
+  }
   for (int side = 0; side < 2; ++side) {
     const Arm& arm = kArms[side];
     const Vector3d sh = s[arm.shoulder].position, el = s[arm.elbow].position, ha = s[arm.hand].position;
     if (good(arm.shoulder) && good(arm.elbow)) a(2 * side) = to_vertical(el - sh);
     if (good(arm.elbow) && good(arm.hand)) a(2 * side + 1) = to_vertical(ha - el);
-    if (o_.set == FeatureSet::Extended && good(arm.shoulder) && good(arm.elbow) && good(arm.hand)) {
+    if (set == FeatureSet::Extended && good(arm.shoulder) && good(arm.elbow) && good(arm.hand)) {
       const Vector3d u = el - sh, f = ha - el;
       if (u.norm() > 1e-9 && f.norm() > 1e-9) {
         a(4 + 2 * side) = std::acos(std::clamp(u.normalized().dot(f.normalized()), -1.0, 1.0));
@@ -77,22 +105,125 @@ VectorXd FeatureStream::step(const skeleton::Skeleton& s, bool* complete) {
       }
     }
   }
+  return a;
+}
+
+}  // namespace
+
+std::vector<std::string> feature_names(FeatureSet set) {
+  const Layout l = layout(set);
+  std::vector<std::string> out = l.values;
+  for (int i = 0; i < l.speeds; ++i) out.push_back(l.values[static_cast<std::size_t>(i)] + "_speed");
+  return out;
+}
+
+std::vector<int> mirror_permutation(FeatureSet set) {
+  const auto names = feature_names(set);
+  std::vector<int> perm(names.size());
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    std::string other = names[i];
+    if (other.rfind("left_", 0) == 0) other = "right_" + other.substr(5);
+    else if (other.rfind("right_", 0) == 0) other = "left_" + other.substr(6);
+    perm[i] = static_cast<int>(std::find(names.begin(), names.end(), other) - names.begin());
+  }
+  return perm;
+}
+
+Sequence mirrored(const Sequence& x, FeatureSet set) {
+  const auto perm = mirror_permutation(set);
+  Sequence out(x.rows(), x.cols());
+  for (std::size_t i = 0; i < perm.size(); ++i) out.col(static_cast<Eigen::Index>(i)) = x.col(perm[i]);
+  return out;
+}
+
+Sequence right_handed(const Sequence& x, FeatureSet set, bool* was) {
+  const auto names = feature_names(set);
+  const Layout l = layout(set);
+  double side[2] = {0, 0};
+  if (x.rows() > 1)
+    for (std::size_t i = 0; i < l.values.size(); ++i) {
+      const int s = names[i].rfind("left_", 0) == 0 ? 0 : names[i].rfind("right_", 0) == 0 ? 1 : -1;
+      if (s < 0) continue;
+      const auto c = x.col(static_cast<Eigen::Index>(i));
+      side[s] += (c.array() - c.mean()).square().sum() / static_cast<double>(x.rows() - 1);
+    }
+  const bool m = side[0] > side[1];
+  if (was) *was = m;
+  return m ? mirrored(x, set) : x;
+}
+
+Span motion_span(const Sequence& x, FeatureSet set, double share, int rest_frames, int pad) {
+  const Eigen::Index T = x.rows(), V = static_cast<Eigen::Index>(layout(set).values.size());
+  if (T == 0) return {0, 0};
+  const Eigen::Index r = std::clamp<Eigen::Index>(rest_frames, 1, T);
+  const auto values = x.leftCols(V);
+  const Eigen::RowVectorXd start = values.topRows(r).colwise().mean(), end = values.bottomRows(r).colwise().mean();
+  Eigen::VectorXd d(T);
+  for (Eigen::Index t = 0; t < T; ++t) d(t) = std::min((values.row(t) - start).norm(), (values.row(t) - end).norm());
+  const double limit = share * d.maxCoeff();
+  Eigen::Index first = -1, last = -1;
+  for (Eigen::Index t = 0; t < T; ++t)
+    if (d(t) > limit && limit > 0) {
+      if (first < 0) first = t;
+      last = t;
+    }
+  if (first < 0) return {0, T};
+  return {std::max<Eigen::Index>(0, first - pad), std::min(T, last + 1 + pad)};
+}
+
+std::optional<FeatureSet> feature_set_from_name(const std::string& name) {
+  if (name == "thesis8") return FeatureSet::Thesis8;
+  if (name == "extended") return FeatureSet::Extended;
+  if (name == "body") return FeatureSet::Body;
+  return std::nullopt;
+}
+
+const char* feature_set_name(FeatureSet set) {
+  switch (set) {
+    case FeatureSet::Thesis8: return "thesis8";
+    case FeatureSet::Extended: return "extended";
+    case FeatureSet::Body: return "body";
+  }
+  return "?";
+}
+
+FeatureStream::FeatureStream(FeatureOptions options) : o_(options) {
+  const Layout l = layout(options.set);
+  values_ = static_cast<int>(l.values.size());
+  speeds_ = l.speeds;
+  signed_speed_ = l.signed_speed;
+  reset();
+}
+
+void FeatureStream::reset() {
+  last_good_ = VectorXd::Zero(values_);
+  have_.assign(static_cast<std::size_t>(values_), false);
+  first_ = true;
+  last_dt_ = 1.0 / 30;
+}
+
+int FeatureStream::size() const { return values_ + speeds_; }
+
+VectorXd FeatureStream::step(const skeleton::Skeleton& s, bool* complete, VectorXd* raw) {
+  const VectorXd a = frame_values(o_.set, s, o_.min_confidence, values_);
+  if (raw) *raw = a;
   bool all = true;
   double dt = last_dt_;
   if (!first_ && s.stamp_ns > last_ns_) dt = static_cast<double>(s.stamp_ns - last_ns_) * 1e-9;
   VectorXd out(size());
-  for (int i = 0; i < angles_; ++i) {
+  for (int i = 0; i < values_; ++i) {
     const auto iu = static_cast<std::size_t>(i);
+    double speed = 0.0;
     if (std::isfinite(a(i))) {
-      out(angles_ + i) = have_[iu] && !first_ ? std::abs(a(i) - last_good_(i)) / dt : 0.0;
+      if (have_[iu] && !first_) speed = (a(i) - last_good_(i)) / dt;
       last_good_(i) = a(i);
       have_[iu] = true;
       out(i) = a(i);
     } else {
       all = false;
-      out(i) = last_good_(i);  // held (0 until a good value has been seen)
-      out(angles_ + i) = 0.0;
+      out(i) = last_good_(i);  // held (0 until a good value has been seen); its speed is 0
     }
+    if (i < speeds_) out(values_ + i) = signed_speed_ ? speed : std::abs(speed);
   }
   last_ns_ = s.stamp_ns;
   last_dt_ = dt;
@@ -105,35 +236,18 @@ Features features_of(const std::vector<skeleton::Skeleton>& frames, const Featur
   FeatureStream fs(options);
   Features f;
   f.x.resize(static_cast<Eigen::Index>(frames.size()), fs.size());
-  const int angles = fs.size() / 2;
-  std::vector<int> first_good(static_cast<std::size_t>(angles), -1);
+  const int values = fs.values();
+  std::vector<int> first_good(static_cast<std::size_t>(values), -1);
   for (std::size_t t = 0; t < frames.size(); ++t) {
     bool complete = false;
-    f.x.row(static_cast<Eigen::Index>(t)) = fs.step(frames[t], &complete).transpose();
+    VectorXd raw;
+    f.x.row(static_cast<Eigen::Index>(t)) = fs.step(frames[t], &complete, &raw).transpose();
     f.complete.push_back(complete);
+    for (int i = 0; i < values; ++i)
+      if (std::isfinite(raw(i)) && first_good[static_cast<std::size_t>(i)] < 0) first_good[static_cast<std::size_t>(i)] = static_cast<int>(t);
   }
-  // Frames before an angle's first good value take that value (the stream had nothing to hold yet).
-  for (std::size_t t = 0; t < frames.size(); ++t) {
-    const auto& s = frames[t];
-    for (int side = 0; side < 2; ++side) {
-      const Arm& arm = kArms[side];
-      const auto good = [&](JointId j) { return s[j].confidence >= options.min_confidence && s[j].position.allFinite(); };
-      const bool upper = good(arm.shoulder) && good(arm.elbow), fore = good(arm.elbow) && good(arm.hand);
-      const bool both = upper && good(arm.hand);
-      const bool ok[4] = {upper, fore, both, both};
-      for (int k = 0; k < 2; ++k) {
-        const int i = 2 * side + k;
-        if (ok[k] && first_good[static_cast<std::size_t>(i)] < 0) first_good[static_cast<std::size_t>(i)] = static_cast<int>(t);
-      }
-      if (angles == 8) {
-        for (int k = 0; k < 2; ++k) {
-          const int i = 4 + 2 * side + k;
-          if (ok[2 + k] && first_good[static_cast<std::size_t>(i)] < 0) first_good[static_cast<std::size_t>(i)] = static_cast<int>(t);
-        }
-      }
-    }
-  }
-  for (int i = 0; i < angles; ++i) {
+  // Frames before a value's first good one take it (the stream had nothing to hold yet).
+  for (int i = 0; i < values; ++i) {
     const int g = first_good[static_cast<std::size_t>(i)];
     for (int t = 0; t < g; ++t) f.x(t, i) = f.x(g, i);
   }

@@ -8,6 +8,14 @@
 // the real frame interval (rad/s; 0 on the first frame).
 // Extended adds, per arm: the elbow bend (angle between upper arm and
 // forearm) and the hand's height above the shoulder in upper-arm lengths.
+// Body: the hand and the elbow relative to the shoulder in the body's frame
+// (out to that arm's side, up, forward: forward is horizontal, square to the
+// shoulder line, so it does not depend on where the sensor is), in arm
+// lengths (upper arm + forearm of that frame); each knee's height relative to
+// its hip in leg lengths (hip -> knee -> foot; walking in place lifts it);
+// then the signed velocities of the hand coordinates and the knee heights
+// (per second). Order: hands, knees, elbows, speeds. Left and right are mirror
+// images: out is away from the body on both sides.
 //
 // Missing joints: a frame where a joint an angle needs is below the minimum
 // confidence keeps that angle's last good value (its speed is then 0) and is
@@ -26,7 +34,7 @@
 
 namespace skelgraph::gesture {
 
-enum class FeatureSet { Thesis8, Extended };
+enum class FeatureSet { Thesis8, Extended, Body };
 
 struct FeatureOptions {
   FeatureSet set = FeatureSet::Thesis8;
@@ -34,19 +42,40 @@ struct FeatureOptions {
 };
 
 std::vector<std::string> feature_names(FeatureSet set);
-std::optional<FeatureSet> feature_set_from_name(const std::string& name);  // "thesis8", "extended"
+std::optional<FeatureSet> feature_set_from_name(const std::string& name);  // "thesis8", "extended", "body"
+const char* feature_set_name(FeatureSet set);
+// Column i of a mirrored sequence is column perm[i] of the original: left and right swapped.
+std::vector<int> mirror_permutation(FeatureSet set);
+Sequence mirrored(const Sequence& x, FeatureSet set);
+// The clip as performed by its more active arm on the right: mirrored when the
+// left arm's values vary more over the clip (sum of variances). `was` (if set)
+// tells whether it mirrored.
+Sequence right_handed(const Sequence& x, FeatureSet set, bool* was = nullptr);
+
+// The part of a clip where the arms move: frames whose values (not speeds)
+// are further than `share` of the clip's largest excursion from both the rest
+// pose at the start and the one at the end (each the mean of the first/last
+// `rest_frames`), padded by `pad` frames. [begin, end); the whole clip when
+// nothing moves.
+struct Span {
+  Eigen::Index begin = 0, end = 0;
+};
+Span motion_span(const Sequence& x, FeatureSet set, double share = 0.2, int rest_frames = 5, int pad = 5);
 
 class FeatureStream {
  public:
   explicit FeatureStream(FeatureOptions options = {});
   // The features of the next frame (its stamp_ns gives the interval); `complete`: every joint was good.
-  Eigen::VectorXd step(const skeleton::Skeleton& s, bool* complete = nullptr);
+  // `raw`: the frame's own values (NaN where missing), before holding.
+  Eigen::VectorXd step(const skeleton::Skeleton& s, bool* complete = nullptr, Eigen::VectorXd* raw = nullptr);
   void reset();
   int size() const;
+  int values() const { return values_; }  // the first values() features; the rest are speeds
 
  private:
   FeatureOptions o_;
-  int angles_ = 0;
+  int values_ = 0, speeds_ = 0;
+  bool signed_speed_ = false;
   Eigen::VectorXd last_good_;
   std::vector<bool> have_;
   std::int64_t last_ns_ = 0;

@@ -1,0 +1,32 @@
+#pragma once
+// Labelled clips for training and cross-validation, read from recorded data
+// sets (playback readers: Kinder-Gator, generic CSV, ...). No DDS.
+
+#include <string>
+#include <vector>
+
+#include "skelgraph/gesture/classifier.hpp"
+#include "skelgraph/playback/readers.hpp"
+
+namespace skelgraph::gesture {
+
+struct DatasetOptions {
+  playback::Format format = playback::Format::KinderGator;
+  FeatureOptions features;
+  bool trim = true;  // keep only the motion_span of each clip (the idle start and end are alike in every class)
+};
+
+// A recording's features as the classifier sees them (trimmed when asked).
+Sequence clip_features(const playback::Recording& recording, const DatasetOptions& options);
+
+// Every file (a directory: its *.csv files, sorted) becomes one clip: the
+// action from the recording's "action" (or "gesture") metadata, the subject
+// from "subject" (else the file name), the label from the class map (-1 if
+// the action is in no class). Throws playback::DataError / ModelError naming
+// the file.
+std::vector<Clip> load_clips(const std::vector<std::string>& paths, const ClassMap& map, const DatasetOptions& options);
+
+// The files `paths` name: files as given, directories expanded to their *.csv files.
+std::vector<std::string> expand_paths(const std::vector<std::string>& paths);
+
+}  // namespace skelgraph::gesture

@@ -1,0 +1,55 @@
+#include "skelgraph/gesture/dataset.hpp"
+
+#include <algorithm>
+#include <filesystem>
+
+namespace skelgraph::gesture {
+
+std::vector<std::string> expand_paths(const std::vector<std::string>& paths) {
+  std::vector<std::string> out;
+  for (const auto& p : paths) {
+    if (!std::filesystem::is_directory(p)) {
+      out.push_back(p);
+      continue;
+    }
+    std::vector<std::string> in_dir;
+    for (const auto& e : std::filesystem::directory_iterator(p))
+      if (e.is_regular_file() && e.path().extension() == ".csv") in_dir.push_back(e.path().string());
+    if (in_dir.empty()) throw ModelError(p + ": no .csv files in this directory");
+    std::sort(in_dir.begin(), in_dir.end());
+    out.insert(out.end(), in_dir.begin(), in_dir.end());
+  }
+  return out;
+}
+
+Sequence clip_features(const playback::Recording& recording, const DatasetOptions& o) {
+  Sequence x = features_of(recording.frames, o.features).x;
+  if (!o.trim) return x;
+  const Span s = motion_span(x, o.features.set);
+  return x.middleRows(s.begin, s.end - s.begin);
+}
+
+std::vector<Clip> load_clips(const std::vector<std::string>& paths, const ClassMap& map, const DatasetOptions& o) {
+  std::vector<Clip> clips;
+  for (const auto& file : expand_paths(paths)) {
+    const auto rec = playback::read_recording(o.format, file);
+    Clip c;
+    c.source = file;
+    const auto meta = [&](const char* k) {
+      const auto it = rec.metadata.find(k);
+      return it == rec.metadata.end() ? std::string() : it->second;
+    };
+    c.action = meta("action");
+    if (c.action.empty()) c.action = meta("gesture");
+    if (c.action.empty()) throw ModelError(file + ": no action label in the recording (expected 'action' or 'gesture' metadata)");
+    c.subject = meta("subject");
+    if (c.subject.empty()) c.subject = std::filesystem::path(file).stem().string();
+    if (rec.frames.size() < 2) throw ModelError(file + ": fewer than 2 frames");
+    c.label = map.label_of(c.action).value_or(-1);
+    c.x = clip_features(rec, o);
+    clips.push_back(std::move(c));
+  }
+  return clips;
+}
+
+}  // namespace skelgraph::gesture

@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# `skelgraph gesture` end to end on the real Kinder-Gator recordings
+# (../shared/data, read in place): train, classify with --json, k-fold
+# cross-validation with an SVG confusion matrix, the features as CSV, and
+# bad input (a class file with an error, a malformed model).
+source "$(dirname "$0")/lib.sh"
+S=$SKELGRAPH
+KG=${SKELGRAPH_DATA_DIR:-$SKELGRAPH_SOURCE_DIR/../shared/data}/kinder-gator/adults
+[ -d "$KG" ] || fail "$KG is missing: tests read ../shared/data (or SKELGRAPH_DATA_DIR)"
+
+# Train on 9 subjects, classify the tenth's pointing and stop clips.
+mkdir -p "$WORK/train"
+for f in "$KG"/*.csv; do case "$f" in *p976_*) ;; *) ln -s "$f" "$WORK/train/";; esac; done
+"$S" gesture train "$WORK/train" --states 5 --out "$WORK/model.json" --json >"$WORK/train.json" 2>"$WORK/train.err" \
+  || fail "gesture train: $(cat "$WORK/train.err")"
+json_check "$WORK/train.json" 'd["clips"] == 144 and d["labels"] == ["point", "other"] and d["config"]["features"] == "thesis8"'
+"$S" gesture classify --model "$WORK/model.json" --json "$KG"/*p976_*Point* "$KG"/*p976_*Walk* >"$WORK/classify.json" \
+  || fail "gesture classify"
+json_check "$WORK/classify.json" 'len(d) == 2 and d[0]["label"] == "point" and d[1]["best"] == "other" and d[0]["scores"]["point"] > d[0]["scores"]["other"]'
+ok "train on 9 subjects, the tenth's pointing clip is pointing and walking is not"
+
+# Five classes, stratified 2-fold, on the labelled clips only.
+mkdir -p "$WORK/five"
+for a in Point-at-the-camera Push-an-imaginary-button Walk-in-place Raise-your-hand- Wave-your-hand-; do ln -s "$KG"/*"$a"* "$WORK/five/"; done
+"$S" gesture cv "$WORK/five" --classes five-class --split kfold --folds 2 --states 3 --svg "$WORK/cm.svg" --json >"$WORK/cv.json" 2>"$WORK/cv.err" \
+  || fail "gesture cv: $(cat "$WORK/cv.err")"
+json_check "$WORK/cv.json" 'sum(map(sum, d["metrics"]["confusion"])) == 50 and d["metrics"]["accuracy"] > 0.4 and len(d["clips"]) == 50 and d["folds"] == 2'
+grep -q "<svg" "$WORK/cm.svg" || fail "no SVG confusion matrix"
+ok "five-class 2-fold cross-validation: confusion matrix over 50 clips, SVG written"
+
+"$S" gesture features "$KG"/*p565_24-Point* >"$WORK/features.csv" || fail "gesture features"
+head -1 "$WORK/features.csv" | grep -q "right_forearm_angle_speed" || fail "features header: $(head -1 "$WORK/features.csv")"
+[ "$(wc -l <"$WORK/features.csv")" -gt 100 ] || fail "features: too few rows"
+ok "features as CSV"
+
+printf 'classes:\n  point: [Point-at-the-camera]\n  stop: [Point-at-the-camera]\n' >"$WORK/bad.yaml"
+"$S" gesture cv "$WORK/five" --classes "$WORK/bad.yaml" 2>"$WORK/bad.err" && fail "a class file with an action in two classes was accepted"
+grep -q "bad.yaml:3" "$WORK/bad.err" || fail "the class-file error does not name the line: $(cat "$WORK/bad.err")"
+echo '{"format": "skelgraph-gesture-classifier", "version": 1}' >"$WORK/bad.json"
+"$S" gesture classify --model "$WORK/bad.json" "$KG"/*p565_24-Point* 2>"$WORK/bad.err" && fail "a malformed model was accepted"
+grep -q "missing field" "$WORK/bad.err" || fail "malformed model error: $(cat "$WORK/bad.err")"
+ok "bad class file and malformed model: clear errors"

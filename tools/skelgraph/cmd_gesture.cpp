@@ -1,0 +1,362 @@
+// skelgraph gesture train|cv|classify: HMM gesture classifiers on recorded data sets.
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <set>
+
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include "cli.hpp"
+#include "skelgraph/gesture/classifier.hpp"
+#include "skelgraph/gesture/dataset.hpp"
+
+namespace skelgraph::cli {
+
+namespace {
+
+using namespace skelgraph::gesture;
+
+struct GestureOptions {
+  std::vector<std::string> inputs;
+  std::string format = "kinder-gator";
+  std::string classes = "two-class";
+  std::string features = "thesis8";
+  int states = 7, mixtures = 1, garbage_mixtures = 0;
+  std::string covariance = "full";
+  std::string hands = "canonical";
+  bool no_trim = false;
+  bool per_class = false;
+  double reject_quantile = 0.02;
+  int iterations = 100;
+  std::uint64_t seed = 1;
+  int threads = 2;
+  bool json = false;
+  // train / classify
+  std::string out, model;
+  // cv
+  std::string split = "lso";
+  int folds = 5;
+  std::string svg;
+  std::vector<int> sweep_states, sweep_mixtures;
+  std::vector<std::string> sweep_covariance;
+  bool sweep = false;
+};
+
+ClassMap class_map(const std::string& c) {
+  const auto& presets = ClassMap::preset_names();
+  if (std::find(presets.begin(), presets.end(), c) != presets.end()) return ClassMap::preset(c);
+  if (!std::filesystem::exists(c)) throw UsageError("--classes: '" + c + "' is neither a preset (two-class, five-class) nor a file");
+  return ClassMap::load(c);
+}
+
+ClassifierOptions classifier_options(const GestureOptions& o) {
+  ClassifierOptions c;
+  c.hmm.states = o.states;
+  c.hmm.mixtures = o.mixtures;
+  c.hmm.covariance = o.covariance == "diag" ? Covariance::Diagonal : Covariance::Full;
+  c.hmm.max_iterations = o.iterations;
+  c.hmm.seed = o.seed;
+  c.garbage_mixtures = o.garbage_mixtures;
+  c.features.set = *feature_set_from_name(o.features);
+  c.hands = *hands_from_name(o.hands);
+  c.per_action = !o.per_class;
+  c.trimmed = !o.no_trim;
+  c.reject_quantile = o.reject_quantile;
+  c.threads = o.threads;
+  return c;
+}
+
+std::vector<Clip> load(const GestureOptions& o, const ClassMap& map, const ClassifierOptions& c) {
+  DatasetOptions d;
+  d.format = *playback::format_from_name(o.format);
+  d.features = c.features;
+  d.trim = c.trimmed;
+  auto clips = load_clips(o.inputs, map, d);
+  std::vector<int> per(map.classes.size(), 0);
+  int unlabelled = 0;
+  for (const auto& clip : clips) clip.label >= 0 ? ++per[static_cast<std::size_t>(clip.label)] : ++unlabelled;
+  std::string counts;
+  for (std::size_t k = 0; k < per.size(); ++k) counts += (k ? ", " : "") + map.classes[k] + " " + std::to_string(per[k]);
+  std::fprintf(stderr, "read %zu clips (%s; %d in no class)\n", clips.size(), counts.c_str(), unlabelled);
+  for (std::size_t k = 0; k < per.size(); ++k)
+    if (per[k] == 0) throw UsageError("no clip of class '" + map.classes[k] + "' in the inputs (check --classes and the actions)");
+  return clips;
+}
+
+std::string pct(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.1f %%", 100 * v);
+  return b;
+}
+
+nlohmann::json config_json(const ClassifierOptions& c) {
+  return {{"features", feature_set_name(c.features.set)},
+          {"states", c.hmm.states},
+          {"mixtures", c.hmm.mixtures},
+          {"garbage_mixtures", c.garbage_mixtures > 0 ? c.garbage_mixtures : c.hmm.mixtures},
+          {"covariance", c.hmm.covariance == Covariance::Full ? "full" : "diag"},
+          {"hands", hands_name(c.hands)},
+          {"per_action", c.per_action},
+          {"trimmed", c.trimmed}};
+}
+
+int gesture_train(const GestureOptions& o) {
+  const auto map = class_map(o.classes);
+  const auto c = classifier_options(o);
+  const auto clips = load(o, map, c);
+  std::fprintf(stderr, "training %zu models ...\n", map.classes.size());
+  const auto model = Classifier::train(clips, map, c);
+  if (!o.out.empty()) model.save(o.out);
+  if (o.json) {
+    nlohmann::json j{{"clips", clips.size()}, {"labels", model.labels()}, {"threshold", model.threshold()},
+                     {"config", config_json(c)}, {"classes", map.to_json()}, {"out", o.out}};
+    std::printf("%s\n", j.dump(2).c_str());
+  } else {
+    std::printf("trained %zu models (%zu classes) on %zu clips; rejection threshold %.3f log-likelihood per frame%s\n", model.models().size(), map.classes.size(),
+                clips.size(), model.threshold(), o.out.empty() ? " (not saved: no --out)" : ("; saved to " + o.out).c_str());
+  }
+  return 0;
+}
+
+struct CvRun {
+  ClassifierOptions config;
+  Metrics metrics;
+  std::vector<ClipResult> results;
+};
+
+CvRun run_cv(const GestureOptions& o, const ClassMap& map, const std::vector<Clip>& clips, const ClassifierOptions& c,
+             const std::string& what) {
+  CvOptions cv;
+  cv.split = o.split == "kfold" ? Split::KFold : Split::LeaveSubjectOut;
+  cv.folds = o.folds;
+  cv.seed = o.seed;
+  const auto results = cross_validate(clips, map, c, cv, [&](int done, int total) {
+    static const bool tty = isatty(fileno(stderr));
+    std::fprintf(stderr, tty ? "\r%s: fold %d/%d" : "%s: fold %d/%d\n", what.c_str(), done, total);
+    if (tty && done == total) std::fprintf(stderr, "\n");
+  });
+  return {c, evaluate(results, map.classes), results};
+}
+
+int gesture_cv(const GestureOptions& o) {
+  const auto map = class_map(o.classes);
+  const auto base = classifier_options(o);
+  const auto clips = load(o, map, base);
+  std::vector<ClassifierOptions> configs;
+  if (o.sweep) {
+    const std::vector<int> states = o.sweep_states.empty() ? std::vector<int>{3, 5, 7, 9} : o.sweep_states;
+    const std::vector<int> mixtures = o.sweep_mixtures.empty() ? std::vector<int>{1, 2, 3} : o.sweep_mixtures;
+    const std::vector<std::string> covs = o.sweep_covariance.empty() ? std::vector<std::string>{"full", "diag"} : o.sweep_covariance;
+    for (const auto& cov : covs)
+      for (int s : states)
+        for (int m : mixtures) {
+          auto c = base;
+          c.hmm.states = s;
+          c.hmm.mixtures = m;
+          c.hmm.covariance = cov == "diag" ? Covariance::Diagonal : Covariance::Full;
+          configs.push_back(c);
+        }
+  } else {
+    configs.push_back(base);
+  }
+  std::vector<CvRun> runs;
+  for (std::size_t i = 0; i < configs.size(); ++i) {
+    const auto& c = configs[i];
+    const std::string what = "config " + std::to_string(i + 1) + "/" + std::to_string(configs.size()) + " (" +
+                             std::to_string(c.hmm.states) + " states, " + std::to_string(c.hmm.mixtures) + " mixtures, " +
+                             (c.hmm.covariance == Covariance::Full ? "full" : "diag") + ")";
+    runs.push_back(run_cv(o, map, clips, c, what));
+  }
+  // The winner: accuracy, then the first class's F1, then detection AUC.
+  std::size_t best = 0;
+  const auto key = [&](const CvRun& r) {
+    return std::make_tuple(r.metrics.accuracy, r.metrics.f1.empty() ? 0.0 : r.metrics.f1[0],
+                           std::isfinite(r.metrics.detection_auc) ? r.metrics.detection_auc : 0.0);
+  };
+  for (std::size_t i = 1; i < runs.size(); ++i)
+    if (key(runs[i]) > key(runs[best])) best = i;
+  const auto& win = runs[best];
+  const std::string split = o.split == "kfold" ? std::to_string(o.folds) + "-fold stratified" : "leave-subject-out";
+  if (!o.svg.empty()) {
+    std::ofstream f(o.svg);
+    f << confusion_svg(win.metrics, split + ", " + o.classes);
+    if (!f) throw std::runtime_error("cannot write " + o.svg);
+  }
+  if (o.json) {
+    nlohmann::json j{{"split", o.split == "kfold" ? "kfold" : "leave-subject-out"},
+                     {"folds", o.split == "kfold" ? o.folds : -1},
+                     {"clips", clips.size()},
+                     {"classes", map.to_json()},
+                     {"config", config_json(win.config)},
+                     {"metrics", to_json(win.metrics)}};
+    auto& per = j["clips"] = nlohmann::json::array();
+    for (const auto& r : win.results) {
+      const auto& clip = clips[r.clip];
+      nlohmann::json scores = nlohmann::json::object();
+      for (std::size_t k = 0; k < map.classes.size(); ++k) scores[map.classes[k]] = r.decision.scores[k];
+      per.push_back({{"file", clip.source},
+                     {"subject", clip.subject},
+                     {"action", clip.action},
+                     {"truth", r.truth >= 0 ? nlohmann::json(map.classes[static_cast<std::size_t>(r.truth)]) : nlohmann::json(nullptr)},
+                     {"predicted", map.classes[static_cast<std::size_t>(r.decision.label)]},
+                     {"rejected", r.decision.rejected},
+                     {"fold", r.fold},
+                     {"scores", scores}});
+    }
+    if (o.sweep) {
+      auto& s = j["sweep"] = nlohmann::json::array();
+      for (const auto& r : runs) {
+        auto e = config_json(r.config);
+        e["accuracy"] = r.metrics.accuracy;
+        e["f1_" + map.classes[0]] = r.metrics.f1[0];
+        s.push_back(e);
+      }
+    }
+    std::printf("%s\n", j.dump(2).c_str());
+    return 0;
+  }
+  if (o.sweep) {
+    std::printf("%-6s %-7s %-9s %-9s %s\n", "states", "mixt.", "cov.", "accuracy", ("F1 " + map.classes[0]).c_str());
+    for (std::size_t i = 0; i < runs.size(); ++i) {
+      const auto& r = runs[i];
+      std::printf("%-6d %-7d %-9s %-9s %.3f%s\n", r.config.hmm.states, r.config.hmm.mixtures,
+                  r.config.hmm.covariance == Covariance::Full ? "full" : "diag", pct(r.metrics.accuracy).c_str(), r.metrics.f1[0],
+                  i == best ? "  <- best" : "");
+    }
+    std::printf("\nbest configuration:\n");
+  }
+  const auto& m = win.metrics;
+  std::printf("%s, %zu clips, features %s, %d states, %d mixtures, %s covariance\n", split.c_str(), clips.size(),
+              feature_set_name(win.config.features.set), win.config.hmm.states, win.config.hmm.mixtures,
+              win.config.hmm.covariance == Covariance::Full ? "full" : "diagonal");
+  std::printf("%s", confusion_text(m).c_str());
+  std::printf("accuracy %s", pct(m.accuracy).c_str());
+  std::printf("; %s precision %.3f recall %.3f F1 %.3f", m.labels[0].c_str(), m.precision[0], m.recall[0], m.f1[0]);
+  if (std::isfinite(m.detection_auc)) std::printf("; detection AUC %.3f", m.detection_auc);
+  std::printf("\nwith rejection: accuracy %s (%d labelled clips rejected", pct(m.accuracy_with_rejection).c_str(), m.rejected_labelled);
+  if (m.unlabelled) std::printf("; %d of %d clips in no class rejected; rejection AUC %.3f", m.unlabelled_rejected, m.unlabelled, m.rejection_auc);
+  std::printf(")\n");
+  if (!o.svg.empty()) std::printf("confusion matrix written to %s\n", o.svg.c_str());
+  return 0;
+}
+
+int gesture_classify(const GestureOptions& o) {
+  const auto model = Classifier::load(o.model);
+  DatasetOptions d;
+  d.format = *playback::format_from_name(o.format);
+  d.features.set = model.feature_set();
+  d.trim = model.trimmed();
+  nlohmann::json all = nlohmann::json::array();
+  for (const auto& file : expand_paths(o.inputs)) {
+    const auto rec = playback::read_recording(d.format, file);
+    const auto x = clip_features(rec, d);
+    const auto dec = model.classify(x);
+    const std::string label = dec.rejected ? "none" : model.labels()[static_cast<std::size_t>(dec.label)];
+    if (o.json) {
+      nlohmann::json s = nlohmann::json::object();
+      for (std::size_t k = 0; k < dec.scores.size(); ++k) s[model.labels()[k]] = dec.scores[k];
+      all.push_back({{"file", file},
+                     {"label", label},
+                     {"best", model.labels()[static_cast<std::size_t>(dec.label)]},
+                     {"rejected", dec.rejected},
+                     {"margin", dec.margin},
+                     {"scores", s}});
+    } else {
+      std::printf("%s: %s (margin %.2f%s)\n", file.c_str(), label.c_str(), dec.margin,
+                  dec.rejected ? (", best " + model.labels()[static_cast<std::size_t>(dec.label)] + " below the threshold").c_str() : "");
+    }
+  }
+  if (o.json) std::printf("%s\n", all.dump(2).c_str());
+  return 0;
+}
+
+int gesture_features(const GestureOptions& o) {
+  FeatureOptions f;
+  f.set = *feature_set_from_name(o.features);
+  const auto format = *playback::format_from_name(o.format);
+  const auto names = feature_names(f.set);
+  std::printf("file,frame,stamp_s,complete");
+  for (const auto& n : names) std::printf(",%s", n.c_str());
+  std::printf("\n");
+  for (const auto& file : expand_paths(o.inputs)) {
+    const auto rec = playback::read_recording(format, file);
+    const auto ft = features_of(rec.frames, f);
+    for (Eigen::Index t = 0; t < ft.x.rows(); ++t) {
+      const auto& s = rec.frames[static_cast<std::size_t>(t)];
+      std::printf("%s,%td,%.4f,%d", file.c_str(), t, static_cast<double>(s.stamp_ns) * 1e-9,
+                  ft.complete[static_cast<std::size_t>(t)] ? 1 : 0);
+      for (Eigen::Index i = 0; i < ft.x.cols(); ++i) std::printf(",%.6g", ft.x(t, i));
+      std::printf("\n");
+    }
+  }
+  return 0;
+}
+
+void add_common(CLI::App* c, GestureOptions& o, bool model_options) {
+  c->add_option("inputs", o.inputs, "recordings (files, or directories of .csv files)")->required()->check(CLI::ExistingPath);
+  c->add_option("--format", o.format, "input format (default kinder-gator)")->check(CLI::IsMember(playback::format_names()));
+  c->add_flag("--json", o.json, "machine-readable output");
+  if (!model_options) return;
+  c->add_flag("--no-trim", o.no_trim, "keep each clip whole (default: only the part where the arms move)");
+  c->add_option("--classes", o.classes, "two-class (point vs garbage; default), five-class, or a class-mapping YAML file");
+  c->add_option("--features", o.features, "feature set: thesis8 (default; the thesis's 8), extended, body")
+      ->check(CLI::IsMember({"body", "thesis8", "extended"}));
+  c->add_option("--states", o.states, "HMM states (default 7)")->check(CLI::Range(1, 50));
+  c->add_option("--mixtures", o.mixtures, "Gaussians per state (default 1)")->check(CLI::Range(1, 20));
+  c->add_option("--garbage-mixtures", o.garbage_mixtures, "Gaussians per state of the garbage model (default: --mixtures)")
+      ->check(CLI::Range(1, 20));
+  c->add_option("--covariance", o.covariance, "full (default) or diag")->check(CLI::IsMember({"full", "diag"}));
+  c->add_option("--hands", o.hands,
+                "canonical (default): mirror every clip so its more active arm is the right; augment: also train on mirrored "
+                "clips; as-is")
+      ->check(CLI::IsMember({"canonical", "augment", "as-is"}));
+  c->add_flag("--per-class", o.per_class, "one model per class (the thesis) instead of one per recorded action");
+  c->add_option("--reject-quantile", o.reject_quantile, "share of held-out training clips the rejection threshold may reject (default 0.02)")
+      ->check(CLI::Range(0.0, 1.0));
+  c->add_option("--iterations", o.iterations, "Baum-Welch iteration cap (default 100)")->check(CLI::Range(1, 10000));
+  c->add_option("--seed", o.seed, "seed for initialisation and folds (default 1)");
+  c->add_option("--threads", o.threads, "worker threads (default 2)")->check(CLI::Range(1, 64));
+}
+
+}  // namespace
+
+void add_gesture_command(CLI::App& app, GlobalOptions&, Action& run) {
+  auto* g = app.add_subcommand("gesture", "Gesture recognition with HMMs: train, cross-validate, classify recorded clips");
+  g->require_subcommand(1);
+  auto o = std::make_shared<GestureOptions>();
+
+  auto* t = g->add_subcommand("train", "Train one HMM per class (and the rejection threshold) on labelled clips");
+  add_common(t, *o, true);
+  t->add_option("--out", o->out, "write the classifier (JSON)");
+  t->callback([o, &run] { run = [o] { return gesture_train(*o); }; });
+
+  auto* cv = g->add_subcommand("cv", "Cross-validate: confusion matrix, accuracy, per-class precision/recall/F1, ROC");
+  add_common(cv, *o, true);
+  cv->add_option("--split", o->split, "lso: leave one subject out (default); kfold: stratified k-fold")
+      ->check(CLI::IsMember({"lso", "kfold"}));
+  cv->add_option("--folds", o->folds, "k for --split kfold (default 5)")->check(CLI::Range(2, 1000));
+  cv->add_option("--svg", o->svg, "write the confusion matrix as SVG");
+  cv->add_flag("--sweep", o->sweep, "try every states x mixtures x covariance combination and report the best");
+  cv->add_option("--sweep-states", o->sweep_states, "states to try (default 3 5 7 9)")->check(CLI::Range(1, 50));
+  cv->add_option("--sweep-mixtures", o->sweep_mixtures, "mixtures to try (default 1 2 3)")->check(CLI::Range(1, 20));
+  cv->add_option("--sweep-covariance", o->sweep_covariance, "covariances to try (default full diag)")
+      ->check(CLI::IsMember({"full", "diag"}));
+  cv->callback([o, &run] { run = [o] { return gesture_cv(*o); }; });
+
+  auto* f = g->add_subcommand("features", "Print the per-frame features of recordings as CSV (what the models see)");
+  add_common(f, *o, false);
+  f->add_option("--features", o->features, "feature set: thesis8 (default; the thesis's 8), extended, body")
+      ->check(CLI::IsMember({"body", "thesis8", "extended"}));
+  f->callback([o, &run] { run = [o] { return gesture_features(*o); }; });
+
+  auto* c = g->add_subcommand("classify", "Classify recordings with a trained classifier");
+  add_common(c, *o, false);
+  c->add_option("--model", o->model, "classifier file from `gesture train`")->required()->check(CLI::ExistingFile);
+  c->callback([o, &run] { run = [o] { return gesture_classify(*o); }; });
+}
+
+}  // namespace skelgraph::cli
