@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <set>
 
 #include "skelgraph/eval/metrics.hpp"
 #include "skelgraph/eval/offline.hpp"
@@ -170,6 +171,32 @@ TEST(Fusion, PeopleStayApartAndKeepTheirIdsWhenOneSensorLosesThem) {
     }
   }
   EXPECT_NE(id_at_x.at(-1), id_at_x.at(1));
+}
+
+TEST(Fusion, TwoTracksOfOnePersonBecomeOne) {
+  // The sensors' first skeletons disagree by a metre (a tracker starting up),
+  // so each starts its own fused person; once they agree, one person remains,
+  // with the first id.
+  for (auto m : {fusion::Method::Avg, fusion::Method::Kalman}) {
+    auto f = make(m);
+    std::set<std::uint32_t> late_ids;
+    std::size_t first_ticks_people = 0;
+    for (int k = 0; k < 90; ++k) {
+      const std::int64_t t = k * 33 * kMs;
+      f.add(in_sensor(person("s1", 1, {0, 1, 0}), kS1), t);
+      f.add(in_sensor(person("s2", 1, k < 3 ? Vector3d(1.0, 1, 0) : Vector3d(0.01, 1, 0)), kS2), t);
+      const auto out = f.fuse(t + kMs);
+      if (k == 1) first_ticks_people = out.size();
+      if (k >= 60) {
+        ASSERT_EQ(out.size(), 1u) << "tick " << k;
+        late_ids.insert(out[0].person_id);
+        EXPECT_EQ(out[0][JointId::Torso].sensor_mask, 3u);
+      }
+    }
+    EXPECT_EQ(first_ticks_people, 2u);  // the premise: two tracks at first
+    EXPECT_EQ(late_ids.size(), 1u);
+    EXPECT_GE(f.stats().tracks_merged, 1u);
+  }
 }
 
 TEST(Fusion, KalmanCorrectsASensorThatSeesTheBack) {

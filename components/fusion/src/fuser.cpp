@@ -161,7 +161,20 @@ struct Fuser::Impl {
     };
     std::vector<View*> open;
     for (auto& v : views) {
-      const auto& bound = v.stream->track;
+      auto& bound = v.stream->track;
+      // Two tracks of one person (the sensors' first skeletons disagreed):
+      // the stream moves to the older track where it is, and the younger one,
+      // left without views, times out. Fused ids stay those of the first track.
+      if (bound && has_track(*bound)) {
+        for (const auto& tr : tracks) {
+          if (tr.id < *bound && !taken(tr.id, v.sensor) && (tr.centre - v.centre).norm() < 0.5 * opt.match_distance_m &&
+              (track_by_id(*bound).centre - tr.centre).norm() < 0.5 * opt.match_distance_m) {
+            bound = tr.id;
+            ++stats.tracks_merged;
+            break;
+          }
+        }
+      }
       if (bound && has_track(*bound) && !taken(*bound, v.sensor) &&
           (track_by_id(*bound).centre - v.centre).norm() < 2 * opt.match_distance_m) {
         by_track[*bound].push_back(&v);

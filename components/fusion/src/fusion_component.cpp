@@ -149,7 +149,8 @@ nlohmann::json FusionComponent::details() const {
           {"samples", st.added},
           {"samples_without_pose", st.no_pose},
           {"flips_corrected", st.flips_corrected},
-          {"gated", st.gated}};
+          {"gated", st.gated},
+          {"tracks_merged", st.tracks_merged}};
 }
 
 }  // namespace skelgraph::fusion

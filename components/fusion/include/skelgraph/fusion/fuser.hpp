@@ -48,6 +48,7 @@ struct FuserOptions {
 
 struct FuserStats {
   std::uint64_t added = 0, no_pose = 0, fused = 0, flips_corrected = 0, gated = 0;
+  std::uint64_t tracks_merged = 0;  // a sensor's stream moved to an older track of the same person
 };
 
 class Fuser {
