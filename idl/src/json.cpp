@@ -110,9 +110,14 @@ void to_json(nlohmann::json& j, const GestureEvent& v) {
   j = {{"label", v.label()},           {"person_id", v.person_id()},
        {"source", v.source()},         {"start_stamp_ns", v.start_stamp_ns()},
        {"end_stamp_ns", v.end_stamp_ns()}, {"score", v.score()},
+       {"log_likelihood", v.log_likelihood()}, {"confidence", v.confidence()},
+       {"arm", v.arm()},               {"has_ray", v.has_ray()},
        {"has_target", v.has_target()}, {"ray_origin", v.ray_origin()},
        {"ray_direction", v.ray_direction()}, {"target", v.target()},
        {"target_name", v.target_name()}};
+}
+void to_json(nlohmann::json& j, const GestureState& v) {
+  j = {{"person_id", v.person_id()}, {"source", v.source()}, {"stamp_ns", v.stamp_ns()}, {"state", v.state()}};
 }
 void to_json(nlohmann::json& j, const TopicStats& v) {
   j = {{"topic", v.topic()}, {"is_output", v.is_output()}, {"count", v.count()},

@@ -257,13 +257,16 @@ TEST(Metrics, MatchHandCountedValues) {
 }
 
 TEST(Classifier, SavesAndLoadsAndRefusesMalformedFiles) {
-  const auto model = Classifier::train(synthetic_clips(8, 3), three_classes(), small_options());
+  auto model = Classifier::train(synthetic_clips(8, 3), three_classes(), small_options());
+  model.set_pointing_correction({3.5, -1.25});
   const auto path = write_temp("model.json", "");
   model.save(path);
   const auto back = Classifier::load(path);
   EXPECT_EQ(back.labels(), model.labels());
   EXPECT_EQ(back.threshold(), model.threshold());
   EXPECT_EQ(back.hands(), model.hands());
+  EXPECT_EQ(back.pointing_correction().elevation, 3.5);
+  EXPECT_EQ(back.pointing_correction().azimuth_out, -1.25);
   std::mt19937_64 rng(9);
   for (int k = 0; k < 3; ++k) {
     const auto x = synthetic(k, rng);
@@ -277,6 +280,9 @@ TEST(Classifier, SavesAndLoadsAndRefusesMalformedFiles) {
   j = model.to_json();
   j.erase("hands");
   EXPECT_NE(error_of([&] { Classifier::from_json(j); }).find("missing field 'hands'"), std::string::npos);
+  j = model.to_json();
+  j["pointing_correction"] = {{"elevation_deg", "up"}};
+  EXPECT_NE(error_of([&] { Classifier::from_json(j); }).find("'pointing_correction' must be"), std::string::npos);
   j = model.to_json();
   j["version"] = 2;
   EXPECT_NE(error_of([&] { Classifier::from_json(j); }).find("unsupported 'version'"), std::string::npos);

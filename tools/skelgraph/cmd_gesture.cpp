@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <set>
 
@@ -13,6 +14,8 @@
 #include "cli.hpp"
 #include "skelgraph/gesture/classifier.hpp"
 #include "skelgraph/gesture/dataset.hpp"
+#include "skelgraph/gesture/sim_sessions.hpp"
+#include "skelgraph/gesture/spotter.hpp"
 
 namespace skelgraph::cli {
 
@@ -44,6 +47,9 @@ struct GestureOptions {
   std::vector<int> sweep_states, sweep_mixtures;
   std::vector<std::string> sweep_covariance;
   bool sweep = false;
+  // sim
+  int train_sessions = 8, test_sessions = 4;
+  SpotterOptions spot;
 };
 
 ClassMap class_map(const std::string& c) {
@@ -296,6 +302,116 @@ int gesture_features(const GestureOptions& o) {
   return 0;
 }
 
+nlohmann::json event_json(const SpottedEvent& e) {
+  nlohmann::json j{{"label", e.label},
+                   {"person_id", e.person_id},
+                   {"start_s", static_cast<double>(e.start_ns) * 1e-9},
+                   {"end_s", static_cast<double>(e.end_ns) * 1e-9},
+                   {"log_likelihood", e.log_likelihood},
+                   {"confidence", e.confidence}};
+  if (e.has_ray) {
+    j["arm"] = e.arm;
+    j["ray_origin"] = {e.ray_origin.x(), e.ray_origin.y(), e.ray_origin.z()};
+    j["ray_direction"] = {e.ray_direction.x(), e.ray_direction.y(), e.ray_direction.z()};
+  }
+  if (e.has_target) {
+    j["target"] = {e.target.x(), e.target.y(), e.target.z()};
+    j["target_name"] = e.target_name;
+  }
+  return j;
+}
+
+// Simulated sessions: train on some, spot on others, score against the truth.
+int gesture_sim(const GestureOptions& o) {
+  auto c = classifier_options(o);
+  c.trimmed = sim_classifier_options().trimmed;
+  const bool tty = isatty(fileno(stderr));
+  const auto progress = [&](const char* what, int done, int total) {
+    std::fprintf(stderr, tty ? "\r%s: session %d/%d" : "%s: session %d/%d\n", what, done, total);
+    if (tty && done == total) std::fprintf(stderr, "\n");
+  };
+  std::size_t clips = 0;
+  const auto model = train_on_sim(o.train_sessions, o.seed, c, &clips,
+                                  [&](int d, int t) { progress("simulating and fusing training sessions", d, t); });
+  if (!o.out.empty()) model.save(o.out);
+  std::vector<SimSession> test;
+  for (int i = 0; i < o.test_sessions; ++i) {
+    // Seeds the training never saw.
+    test.push_back(simulate_session((o.seed + 1) * 1000 + 500 + static_cast<std::uint64_t>(i)));
+    progress("simulating and fusing test sessions", i + 1, o.test_sessions);
+  }
+  std::vector<SpottedEvent> events;
+  std::vector<SpottingReport> reports;
+  nlohmann::json per = nlohmann::json::array();
+  for (const auto& s : test) {
+    std::map<std::uint32_t, Spotter> spotters;  // one per fused person
+    std::vector<SpottedEvent> ev;
+    for (const auto& f : s.fused)
+      for (auto& e : spotters.try_emplace(f.person_id, model, o.spot).first->second.step(f)) ev.push_back(e);
+    const auto r = score_spotting(ev, s.truth, "point");
+    if (std::getenv("GHOST_DEBUG")) {
+      std::map<std::int64_t, const skeleton::Skeleton*> p1;
+      for (const auto& f : s.fused) if (f.person_id == 1) p1[f.stamp_ns] = &f;
+      int k = 0;
+      for (const auto& f : s.fused) if (f.person_id == 2 && p1.count(f.stamp_ns) && k++ % 100 == 0) {
+        const auto& a = *p1[f.stamp_ns];
+        std::fprintf(stderr, "t %.2f torso1 %.2f %.2f %.2f torso2 %.2f %.2f %.2f sensors %x %x\n", f.stamp_ns*1e-9, a[skeleton::JointId::Torso].position.x(), a[skeleton::JointId::Torso].position.y(), a[skeleton::JointId::Torso].position.z(), f[skeleton::JointId::Torso].position.x(), f[skeleton::JointId::Torso].position.y(), f[skeleton::JointId::Torso].position.z(), a[skeleton::JointId::Torso].sensor_mask, f[skeleton::JointId::Torso].sensor_mask);
+      }
+    }
+    std::map<std::string, int> people;
+    for (const auto& f : s.fused) ++people[std::to_string(f.person_id)];
+    nlohmann::json tj = nlohmann::json::array();
+    for (const auto& g : s.truth) {
+      nlohmann::json e{{"label", g.label}, {"start_s", static_cast<double>(g.start_ns) * 1e-9}, {"end_s", static_cast<double>(g.end_ns) * 1e-9}};
+      if (g.hold_ns >= 0) e["hold_s"] = static_cast<double>(g.hold_ns) * 1e-9;
+      if (g.has_target) e["target"] = {g.target.x(), g.target.y(), g.target.z()};
+      if (g.has_ray) {
+        e["ray_origin"] = {g.ray_origin.x(), g.ray_origin.y(), g.ray_origin.z()};
+        e["ray_direction"] = {g.ray_direction.x(), g.ray_direction.y(), g.ray_direction.z()};
+      }
+      tj.push_back(e);
+    }
+    nlohmann::json evj = nlohmann::json::array();
+    for (const auto& e : ev) evj.push_back(event_json(e));
+    per.push_back({{"truth_points", r.truth}, {"events", r.events}, {"f1", r.f1}, {"fused_frames_per_person", people},
+                   {"truth", tj}, {"spotted", evj}});
+    events.insert(events.end(), ev.begin(), ev.end());
+    reports.push_back(r);
+  }
+  const auto r = combine(reports);  // each session scored against its own truth (their clocks overlap)
+  if (o.json) {
+    nlohmann::json ev = nlohmann::json::array();
+    for (const auto& e : events) ev.push_back(event_json(e));
+    std::printf("%s\n", nlohmann::json{{"train_sessions", o.train_sessions},
+                                        {"test_sessions", o.test_sessions},
+                                        {"seed", o.seed},
+                                        {"clips", clips},
+                                        {"config", config_json(c)},
+                                        {"model", o.out},
+                                        {"pointing_correction_deg", {{"elevation", model.pointing_correction().elevation},
+                                                                     {"azimuth_out", model.pointing_correction().azimuth_out}}},
+                                        {"spotting", to_json(r)},
+                                        {"sessions", per},
+                                        {"events", ev}}
+                            .dump(2)
+                            .c_str());
+    return 0;
+  }
+  std::printf("trained on %zu clips of %d simulated sessions%s; spotted on %d others:\n", clips, o.train_sessions,
+              o.out.empty() ? "" : (" (model: " + o.out + ")").c_str(), o.test_sessions);
+  std::printf("pointing: %d true, %d events: precision %.3f recall %.3f F1 %.3f\n", r.truth, r.events, r.precision, r.recall, r.f1);
+  std::printf("pointing correction learnt on the training sessions: rays lowered %.1f deg, turned in %.1f deg\n",
+              model.pointing_correction().elevation, model.pointing_correction().azimuth_out);
+  std::printf("latency: median %.0f ms after the hold began, %.0f ms from the end of the gesture (negative: before)\n",
+              1e3 * r.median_latency_hold_s, 1e3 * r.median_latency_s);
+  if (!r.target_error_m.empty())
+    std::printf("target on the floor: median error %.1f cm, largest %.1f cm over %zu events; ray direction: median %.1f deg off\n",
+                100 * r.median_target_error_m, 100 * r.max_target_error_m, r.target_error_m.size(), r.median_ray_error_deg);
+  return 0;
+}
+
+void add_model_options(CLI::App* c, GestureOptions& o);
+
 void add_common(CLI::App* c, GestureOptions& o, bool model_options) {
   c->add_option("inputs", o.inputs, "recordings (files, or directories of .csv files)")->required()->check(CLI::ExistingPath);
   c->add_option("--format", o.format, "input format (default kinder-gator)")->check(CLI::IsMember(playback::format_names()));
@@ -303,6 +419,10 @@ void add_common(CLI::App* c, GestureOptions& o, bool model_options) {
   if (!model_options) return;
   c->add_flag("--no-trim", o.no_trim, "keep each clip whole (default: only the part where the arms move)");
   c->add_option("--classes", o.classes, "two-class (point vs garbage; default), five-class, or a class-mapping YAML file");
+  add_model_options(c, o);
+}
+
+void add_model_options(CLI::App* c, GestureOptions& o) {
   c->add_option("--features", o.features, "feature set: thesis8 (default; the thesis's 8), extended, body")
       ->check(CLI::IsMember({"body", "thesis8", "extended"}));
   c->add_option("--states", o.states, "HMM states (default 7)")->check(CLI::Range(1, 50));
@@ -352,6 +472,18 @@ void add_gesture_command(CLI::App& app, GlobalOptions&, Action& run) {
   f->add_option("--features", o->features, "feature set: thesis8 (default; the thesis's 8), extended, body")
       ->check(CLI::IsMember({"body", "thesis8", "extended"}));
   f->callback([o, &run] { run = [o] { return gesture_features(*o); }; });
+
+  auto* sm = g->add_subcommand("sim", "Simulated pointing sessions (no outside data): train a classifier on some, spot "
+                                     "gestures in the others' fused stream and score precision, recall, latency and target error");
+  sm->add_flag("--json", o->json, "machine-readable output");
+  add_model_options(sm, *o);
+  sm->add_option("--train-sessions", o->train_sessions, "sessions to train on (default 8)")->check(CLI::Range(1, 200));
+  sm->add_option("--test-sessions", o->test_sessions, "sessions to spot on (default 4)")->check(CLI::Range(1, 200));
+  sm->add_option("--out", o->out, "write the trained classifier (JSON), e.g. for the gesture component");
+  sm->add_option("--hold", o->spot.hold, "s an extended arm is held before pointing is tried (default 0.25)")->check(CLI::Range(0.0, 5.0));
+  sm->add_option("--still-speed", o->spot.still_speed, "m/s below which a hand is still (default 0.25)")->check(CLI::Range(0.01, 5.0));
+  sm->add_option("--window", o->spot.window, "s over which hand speed is measured (default 0.25)")->check(CLI::Range(0.03, 2.0));
+  sm->callback([o, &run] { run = [o] { return gesture_sim(*o); }; });
 
   auto* c = g->add_subcommand("classify", "Classify recordings with a trained classifier");
   add_common(c, *o, false);

@@ -278,6 +278,7 @@ nlohmann::json Classifier::to_json() const {
           {"features", feature_set_name(features_)},
           {"hands", hands_name(hands_)},
           {"trimmed", trimmed_},
+          {"pointing_correction", {{"elevation_deg", pointing_.elevation}, {"azimuth_out_deg", pointing_.azimuth_out}}},
           {"models", models}};
 }
 
@@ -304,6 +305,13 @@ Classifier Classifier::from_json(const nlohmann::json& j) {
   c.hands_ = *hands;
   if (!need("trimmed").is_boolean()) throw ModelError("classifier: 'trimmed' must be true or false");
   c.trimmed_ = need("trimmed").get<bool>();
+  if (j.contains("pointing_correction")) {
+    const auto& p = j["pointing_correction"];
+    if (!p.is_object() || !p.contains("elevation_deg") || !p["elevation_deg"].is_number() || !p.contains("azimuth_out_deg") ||
+        !p["azimuth_out_deg"].is_number())
+      throw ModelError("classifier: 'pointing_correction' must be {elevation_deg: number, azimuth_out_deg: number}");
+    c.pointing_ = {p["elevation_deg"].get<double>(), p["azimuth_out_deg"].get<double>()};
+  }
   const int K = static_cast<int>(c.labels_.size());
   if (c.garbage_ < -1 || c.garbage_ >= K) throw ModelError("classifier: 'garbage' is not a label index or -1");
   const auto& models = need("models");

@@ -201,21 +201,44 @@ void script_arms(Builder& b) {
   }
 }
 
+// Pointing at the floor of the cell (the arm straight, 35-65 degrees from
+// hanging down, so the ray meets the floor 1-3 m away), with either arm,
+// between waves and overhead stretches that are not pointing. Phases:
+// raise:SIDE, hold:SIDE, retract:SIDE for pointing; wave:SIDE, stretch:SIDE
+// for the others; rest between.
 void script_point(Builder& b, Rng& rng) {
   const BodyPose rest = b.cur;
-  for (int i = 0; i < 8; ++i) {
+  for (int i = 0; i < 10; ++i) {
     const bool right = rng.chance(0.5);
-    ArmPose aim;
-    aim.elevation = deg(rng.uniform(60.0, 115.0));
-    aim.azimuth = deg(rng.uniform(-20.0, 80.0));  // positive: out to that arm's side
-    aim.elbow_flex = 0.05;
     const std::string side = right ? "right" : "left";
+    const int kind = i % 5 == 2 ? 1 : i % 5 == 4 ? 2 : 0;  // 6 points, 2 waves, 2 stretches
     BodyPose p = rest;
-    (right ? p.right_arm : p.left_arm) = aim;
+    ArmPose& arm = right ? p.right_arm : p.left_arm;
     b.hold(rng.uniform(1.0, 2.5), "rest");
-    b.to(p, rng.uniform(0.5, 1.3), "raise:" + side);
-    b.hold(rng.uniform(0.8, 2.0), "hold:" + side);
-    b.to(rest, rng.uniform(0.5, 1.2), "retract:" + side);
+    if (kind == 0) {
+      arm.elevation = deg(rng.uniform(35.0, 65.0));
+      arm.azimuth = deg(rng.uniform(-20.0, 60.0));  // positive: out to that arm's side
+      arm.elbow_flex = 0.05;
+      b.to(p, rng.uniform(0.5, 1.3), "raise:" + side);
+      b.hold(rng.uniform(0.8, 2.0), "hold:" + side);
+      b.to(rest, rng.uniform(0.5, 1.2), "retract:" + side);
+    } else if (kind == 1) {
+      arm = {deg(rng.uniform(120.0, 150.0)), deg(rng.uniform(30.0, 70.0)), deg(40), 0.0};
+      b.to(p, rng.uniform(0.5, 0.9), "wave:" + side);
+      const int swings = 2 + static_cast<int>(rng.uniform(0.0, 3.0));
+      for (int k = 0; k < 2 * swings; ++k) {
+        BodyPose q = p;
+        (right ? q.right_arm : q.left_arm).elbow_flex = deg(k % 2 ? 20.0 : 70.0);
+        (right ? q.right_arm : q.left_arm).azimuth += deg(k % 2 ? -15.0 : 15.0);
+        b.to(q, rng.uniform(0.2, 0.35), "wave:" + side);
+      }
+      b.to(rest, rng.uniform(0.5, 1.0), "wave:" + side);
+    } else {
+      arm = {deg(rng.uniform(160.0, 175.0)), deg(rng.uniform(0.0, 40.0)), 0.1, 0.0};
+      b.to(p, rng.uniform(0.6, 1.2), "stretch:" + side);
+      b.hold(rng.uniform(0.5, 1.0), "stretch:" + side);
+      b.to(rest, rng.uniform(0.6, 1.2), "stretch:" + side);
+    }
   }
   b.hold(1.0, "rest");
 }

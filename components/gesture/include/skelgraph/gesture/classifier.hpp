@@ -75,6 +75,15 @@ struct Decision {
   double margin = 0.0;            // best score minus the next best
 };
 
+// A constant correction of pointing rays, learnt against known targets
+// (`gesture sim` against the simulator's truth): trackers place the hand and
+// shoulder joints where they are not, so the shoulder -> hand ray is off by
+// a repeatable angle. Degrees: the ray is lowered by `elevation` and turned
+// inwards (towards the body's midline) by `azimuth_out`.
+struct PointingCorrection {
+  double elevation = 0.0, azimuth_out = 0.0;
+};
+
 class Classifier {
  public:
   // Trains the models of every class on the clips with a label (>= 0): one per
@@ -91,8 +100,11 @@ class Classifier {
   FeatureSet feature_set() const { return features_; }
   Hands hands() const { return hands_; }
   bool trimmed() const { return trimmed_; }
+  const PointingCorrection& pointing_correction() const { return pointing_; }
+  void set_pointing_correction(const PointingCorrection& p) { pointing_ = p; }
 
   // "skelgraph-gesture-classifier" version 1: labels, garbage, threshold, feature set, hands, trimmed,
+  // pointing_correction {elevation_deg, azimuth_out_deg} (optional, default 0),
   // models (each a skelgraph-hmm with its class index and the action it was trained on).
   nlohmann::json to_json() const;
   static Classifier from_json(const nlohmann::json& j);  // throws ModelError naming the field
@@ -107,6 +119,7 @@ class Classifier {
   int garbage_ = -1;
   Hands hands_ = Hands::Canonical;
   bool trimmed_ = true;
+  PointingCorrection pointing_;
   double threshold_ = -1e300;
   FeatureSet features_ = FeatureSet::Thesis8;
 };

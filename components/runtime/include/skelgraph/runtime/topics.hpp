@@ -49,6 +49,8 @@ inline const TopicDef<msg::DepthFrame> kDepth{"skelgraph/depth", {R::BestEffort,
 // that do not know the key (generic tools such as `topic echo`).
 inline const TopicDef<msg::SensorPose> kCalibration{"skelgraph/calibration", {R::Reliable, D::TransientLocal, 32}};
 inline const TopicDef<msg::GestureEvent> kGestureEvent{"skelgraph/gesture/event", {R::Reliable, D::Volatile, 0}};
+// Keyed by person in spirit: the latest state of each person reaches late joiners.
+inline const TopicDef<msg::GestureState> kGestureState{"skelgraph/gesture/state", {R::Reliable, D::TransientLocal, 16}};
 inline const TopicDef<msg::ComponentStatus> kStatus{"skelgraph/status", {R::BestEffort, D::Volatile, 1}};
 
 }  // namespace topics

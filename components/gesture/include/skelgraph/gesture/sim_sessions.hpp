@@ -1,0 +1,45 @@
+#pragma once
+// Simulated pointing sessions for training and measuring the spotter without
+// outside data: the simulator's `point` scenario (pointing at the floor with
+// either arm, between waves and stretches), its trackers fused offline with
+// the Kalman method (what the live `gesture` component sees), and the true
+// gestures from the scenario's phases with the true pointing targets. No DDS.
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "skelgraph/gesture/classifier.hpp"
+#include "skelgraph/gesture/spotter.hpp"
+#include "skelgraph/skeleton/skeleton.hpp"
+
+namespace skelgraph::gesture {
+
+struct SimSession {
+  std::vector<skeleton::Skeleton> fused;  // person 1's fused skeletons (world frame), in time order
+  std::vector<TruthGesture> truth;        // label point (with hold start and target), wave or stretch
+  std::vector<std::pair<std::int64_t, std::int64_t>> rest;  // spans where the person stands at rest
+};
+
+// One session of the point scenario with this seed (people = 1, the default two sensors).
+SimSession simulate_session(std::uint64_t seed, const Surface& floor = {});
+
+// Labelled clips cut from sessions: each true gesture (action point, wave or
+// stretch; from `pad` s before to `pad` s after) and one rest clip per rest
+// span longer than 1 s (action rest). Subject: "sim<seed index>".
+std::vector<Clip> session_clips(const std::vector<SimSession>& sessions, const ClassMap& map, FeatureSet set, double pad = 0.17);
+
+// point vs everything else (garbage "other"), for sessions.
+ClassMap sim_class_map();
+
+// The classifier options for simulated sessions: thesis8 features, the
+// right-handed canonical form, clips not trimmed (they are cut at the true
+// gesture bounds; the spotter cuts its own segments).
+ClassifierOptions sim_classifier_options();
+
+// A classifier trained on `sessions` simulated sessions (seeds seed*1000 + i),
+// and the clips it was trained on (count) for reports.
+Classifier train_on_sim(int sessions, std::uint64_t seed, const ClassifierOptions& options, std::size_t* clips = nullptr,
+                        const std::function<void(int done, int total)>& progress = {});
+
+}  // namespace skelgraph::gesture

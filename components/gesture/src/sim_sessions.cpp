@@ -1,0 +1,178 @@
+#include "skelgraph/gesture/sim_sessions.hpp"
+
+#include <algorithm>
+#include <map>
+
+#include "skelgraph/eval/offline.hpp"
+#include "skelgraph/sim/simulation.hpp"
+
+namespace skelgraph::gesture {
+
+using Eigen::Vector3d;
+using skeleton::JointId;
+
+SimSession simulate_session(std::uint64_t seed, const Surface& floor) {
+  sim::SimConfig cfg;
+  cfg.scenario.name = "point";
+  cfg.scenario.seed = seed;
+  sim::Simulation simulation(cfg);
+  std::map<std::string, Eigen::Isometry3d> poses;
+  for (const auto& s : cfg.sensors) poses[s.id] = s.world_from_sensor();
+  std::vector<eval::TimedSkeleton> events;
+  struct TruthFrame {
+    std::int64_t t;
+    std::string phase;
+    skeleton::Skeleton s;
+  };
+  std::vector<TruthFrame> truth;
+  for (auto& e : simulation.advance(simulation.duration() + 1.0)) {
+    const auto t = cfg.epoch_ns + static_cast<std::int64_t>(std::llround(e.t * 1e9));
+    if (e.kind == sim::SimEvent::Kind::Truth) {
+      std::string phase;
+      for (const auto& a : simulation.scenario().at(e.t).actors)
+        if (a.person_id == e.actor) phase = a.phase;
+      truth.push_back({t, phase, e.skeleton});
+      events.push_back({eval::TimedSkeleton::Kind::Truth, t, std::move(e.skeleton)});
+    } else if (e.kind == sim::SimEvent::Kind::Raw) {
+      events.push_back({eval::TimedSkeleton::Kind::Raw, t, std::move(e.skeleton)});
+    }
+  }
+  std::stable_sort(events.begin(), events.end(), [](const auto& a, const auto& b) { return a.t_ns < b.t_ns; });
+  SimSession out;
+  eval::OfflineOptions eo;
+  eo.methods = {fusion::Method::Kalman};
+  eo.singles = false;
+  eval::evaluate(poses, events, eo, [&](fusion::Method, const skeleton::Skeleton& s) { out.fused.push_back(s); });
+
+  // Runs of non-rest phases are gestures.
+  for (std::size_t i = 0; i < truth.size();) {
+    if (truth[i].phase == "rest") {
+      std::size_t j = i;
+      while (j < truth.size() && truth[j].phase == "rest") ++j;
+      out.rest.emplace_back(truth[i].t, truth[j - 1].t);
+      i = j;
+      continue;
+    }
+    std::size_t j = i;
+    while (j < truth.size() && truth[j].phase != "rest") ++j;
+    TruthGesture g;
+    g.start_ns = truth[i].t;
+    g.end_ns = truth[j - 1].t;
+    g.label = truth[i].phase.substr(0, truth[i].phase.find(':'));
+    Vector3d target = Vector3d::Zero(), origin = Vector3d::Zero(), dir = Vector3d::Zero();
+    int hits = 0, holds = 0;
+    for (std::size_t k = i; k < j; ++k) {
+      const auto& p = truth[k].phase;
+      if (p.rfind("hold:", 0) != 0) continue;
+      g.label = "point";
+      if (g.hold_ns < 0) g.hold_ns = truth[k].t;
+      const bool right = p == "hold:right";
+      const auto& s = truth[k].s;
+      const Vector3d sh = s[right ? JointId::RightShoulder : JointId::LeftShoulder].position;
+      const Vector3d ha = s[right ? JointId::RightHand : JointId::LeftHand].position;
+      origin += sh;
+      dir += (ha - sh).normalized();
+      ++holds;
+      if (const auto hit = intersect(sh, (ha - sh).normalized(), floor)) {
+        target += *hit;
+        ++hits;
+      }
+    }
+    if (g.label == "raise") g.label = "point";
+    if (holds > 0) {
+      g.has_ray = true;
+      g.ray_origin = origin / holds;
+      g.ray_direction = dir.normalized();
+    }
+    if (hits > 0) {
+      g.has_target = true;
+      g.target = target / hits;
+    }
+    out.truth.push_back(g);
+    i = j;
+  }
+  return out;
+}
+
+ClassMap sim_class_map() {
+  ClassMap m;
+  m.classes = {"point", "other"};
+  m.action_class = {{"point", "point"}};
+  m.garbage = "other";
+  return m;
+}
+
+std::vector<Clip> session_clips(const std::vector<SimSession>& sessions, const ClassMap& map, FeatureSet set, double pad) {
+  std::vector<Clip> clips;
+  const auto pad_ns = static_cast<std::int64_t>(pad * 1e9);
+  for (std::size_t n = 0; n < sessions.size(); ++n) {
+    const auto& s = sessions[n];
+    const auto cut = [&](std::int64_t from, std::int64_t to, const std::string& action) {
+      std::vector<skeleton::Skeleton> frames;
+      for (const auto& f : s.fused)
+        if (f.stamp_ns >= from && f.stamp_ns <= to) frames.push_back(f);
+      if (frames.size() < 5) return;
+      Clip c;
+      c.action = action;
+      c.subject = "sim" + std::to_string(n);
+      c.source = c.subject + ":" + action + "@" + std::to_string(from);
+      c.label = map.label_of(action).value_or(-1);
+      c.x = features_of(frames, FeatureOptions{set, skeleton::kTracked}).x;
+      clips.push_back(std::move(c));
+    };
+    for (const auto& g : s.truth) cut(g.start_ns - pad_ns, g.end_ns + pad_ns, g.label);
+    for (const auto& [a, b] : s.rest)
+      if (b - a > 1'000'000'000) cut(a + (b - a) / 2 - 500'000'000, a + (b - a) / 2 + 500'000'000, "rest");
+  }
+  return clips;
+}
+
+}  // namespace skelgraph::gesture
+
+namespace skelgraph::gesture {
+
+ClassifierOptions sim_classifier_options() {
+  ClassifierOptions c;
+  c.features.set = FeatureSet::Thesis8;
+  c.hands = Hands::Canonical;
+  c.trimmed = false;
+  return c;
+}
+
+Classifier train_on_sim(int sessions, std::uint64_t seed, const ClassifierOptions& options, std::size_t* clips,
+                        const std::function<void(int, int)>& progress) {
+  std::vector<SimSession> train;
+  for (int i = 0; i < sessions; ++i) {
+    train.push_back(simulate_session(seed * 1000 + static_cast<std::uint64_t>(i)));
+    if (progress) progress(i + 1, sessions);
+  }
+  const auto map = sim_class_map();
+  const auto c = session_clips(train, map, options.features.set);
+  if (clips) *clips = c.size();
+  auto model = Classifier::train(c, map, options);
+  // The pointing correction: the median angles by which the spotted rays miss the true ones.
+  std::vector<double> el, az;
+  for (const auto& s : train) {
+    std::map<std::uint32_t, Spotter> spotters;
+    for (const auto& f : s.fused)
+      for (const auto& e : spotters.try_emplace(f.person_id, model).first->second.step(f)) {
+        if (!e.has_ray) continue;
+        for (const auto& g : s.truth)
+          if (g.label == "point" && g.has_ray && e.end_ns >= g.start_ns - 500'000'000 && e.end_ns <= g.end_ns + 500'000'000) {
+            const auto off = ray_offset(e.ray_direction, g.ray_direction, e.out);
+            el.push_back(off.elevation);
+            az.push_back(off.azimuth_out);
+            break;
+          }
+      }
+  }
+  const auto median = [](std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+    return v[v.size() / 2];
+  };
+  model.set_pointing_correction({median(el), median(az)});
+  return model;
+}
+
+}  // namespace skelgraph::gesture
