@@ -40,3 +40,10 @@ echo '{"format": "skelgraph-gesture-classifier", "version": 1}' >"$WORK/bad.json
 "$S" gesture classify --model "$WORK/bad.json" "$KG"/*p565_24-Point* 2>"$WORK/bad.err" && fail "a malformed model was accepted"
 grep -q "missing field" "$WORK/bad.err" || fail "malformed model error: $(cat "$WORK/bad.err")"
 ok "bad class file and malformed model: clear errors"
+
+# Continuous streams: three subjects, each spotted by a model trained on the other two.
+mkdir -p "$WORK/three"
+for f in "$KG"/*p565_* "$KG"/*p604_* "$KG"/*p734_*; do ln -s "$f" "$WORK/three/"; done
+"$S" gesture spot "$WORK/three" --states 5 --json >"$WORK/spot.json" 2>"$WORK/spot.err" || fail "gesture spot: $(cat "$WORK/spot.err")"
+json_check "$WORK/spot.json" 'd["spotting"]["truth"] == 3 and len(d["subjects"]) == 3 and d["spotting"]["events"] == d["spotting"]["true_positive"] + d["spotting"]["false_positive"]'
+ok "spotting in continuous streams of real clips, leave-subject-out"

@@ -245,7 +245,13 @@ Classifier Classifier::train(const std::vector<Clip>& clips, const ClassMap& map
   c.model_action_ = std::move(m.action);
   // Threshold: a low quantile of the clips' own-class scores, held out by inner folds when asked.
   std::vector<double> own;
-  if (o.calibration_folds >= 2) {
+  // Held-out scores need every class in every inner fold's training part.
+  std::map<int, int> per_class;
+  for (const auto& clip : clips)
+    if (clip.label >= 0) ++per_class[clip.label];
+  bool enough = true;
+  for (const auto& [k, n] : per_class) enough = enough && n >= o.calibration_folds;
+  if (o.calibration_folds >= 2 && enough) {
     ClassifierOptions inner = o;
     inner.calibration_folds = 0;
     CvOptions cv;

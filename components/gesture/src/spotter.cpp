@@ -264,6 +264,7 @@ std::optional<SpottedEvent> Spotter::decide(std::int64_t now_ns, bool early) {
         }
       }
     }
+    if (!e.has_ray) return std::nullopt;  // no arm was held out: whatever the models say, this was not pointing
   }
   return e;
 }

@@ -19,7 +19,8 @@
 // length) has been held still for `hold` s, the segment so far is classified;
 // if the point class wins and is not rejected, the event goes out then, with
 // the ray averaged over the hold. Any other segment is classified when it
-// closes; an event goes out when its class is neither garbage nor rejected.
+// closes; an event goes out when its class is neither garbage nor rejected,
+// and for pointing only when an extended arm was held in the segment.
 
 #include <cstdint>
 #include <deque>
