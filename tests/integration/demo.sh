@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
 # The main job as a user runs it: `skelgraph demo` runs the live graph
 # (simulated two-sensor cell, sync, recorder, fusion with every method),
-# scores the session's recording, evaluates the seven scenarios offline and
-# writes one report.
+# scores the session's recording, measures pointing on simulated sessions,
+# evaluates the seven scenarios offline and writes one report.
 source "$(dirname "$0")/lib.sh"
 
 "$SKELGRAPH" demo --duration 6 --json --report "$WORK/report" >"$WORK/demo.json" 2>"$WORK/demo.err" ||
   fail "demo: $(tail -5 "$WORK/demo.err")"
-grep -q "\[demo 3/3\]" "$WORK/demo.err" || fail "demo shows no progress: $(head -c 2000 "$WORK/demo.err")"
+grep -q "\[demo 4/4\]" "$WORK/demo.err" || fail "demo shows no progress: $(head -c 2000 "$WORK/demo.err")"
 python3 - "$WORK/demo.json" <<'PY' || fail "demo report: $(head -c 3000 "$WORK/demo.json")"
 import json, os, sys
 d = json.load(open(sys.argv[1]))
@@ -16,6 +16,9 @@ html = open(d["report"]).read()
 for s in ("walk", "360", "hide", "box", "occ", "sit", "arms"):
     assert "<h2>%s (2 sensors" % s in html, s
 assert "<h2>live graph" in html
+assert "<h2>Pointing" in html
+p = d["pointing"]
+assert p["truth"] == 24 and p["recall"] >= 0.8 and p["precision"] >= 0.8 and p["median_target_error_m"] < 0.4, p
 c = {x["name"]: x for x in d["components"]}
 assert all(x["state"] == "OK" for x in c.values()), {k: (v["state"], v["message"]) for k, v in c.items()}
 methods = ("avg", "sum", "facing", "weighted", "kalman")
@@ -37,4 +40,4 @@ off, on = streams["kalman"]["mean_error_cm"], streams["live kalman"]["mean_error
 assert abs(off - on) < 0.25 * off + 1.0, (off, on)
 print("report %s; recording %s; kalman offline %.1f cm, live %.1f cm" % (d["report"], d["recording"], off, on))
 PY
-ok "demo: live graph (every method) recorded and scored, seven scenarios, one report"
+ok "demo: live graph (every method) recorded and scored, pointing, seven scenarios, one report"

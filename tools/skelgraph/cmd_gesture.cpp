@@ -416,30 +416,15 @@ int gesture_sim(const GestureOptions& o) {
   const auto model = train_on_sim(o.train_sessions, o.seed, c, &clips,
                                   [&](int d, int t) { progress("simulating and fusing training sessions", d, t); });
   if (!o.out.empty()) model.save(o.out);
-  std::vector<SimSession> test;
-  for (int i = 0; i < o.test_sessions; ++i) {
-    // Seeds the training never saw.
-    test.push_back(simulate_session((o.seed + 1) * 1000 + 500 + static_cast<std::uint64_t>(i)));
-    progress("simulating and fusing test sessions", i + 1, o.test_sessions);
-  }
+  const auto test = held_out_sessions(o.test_sessions, o.seed, [&](int d, int t) { progress("simulating and fusing test sessions", d, t); });
+  const auto spotted = spot_sessions(model, test, o.spot);
   std::vector<SpottedEvent> events;
   std::vector<SpottingReport> reports;
   nlohmann::json per = nlohmann::json::array();
-  for (const auto& s : test) {
-    std::map<std::uint32_t, Spotter> spotters;  // one per fused person
-    std::vector<SpottedEvent> ev;
-    for (const auto& f : s.fused)
-      for (auto& e : spotters.try_emplace(f.person_id, model, o.spot).first->second.step(f)) ev.push_back(e);
-    const auto r = score_spotting(ev, s.truth, "point");
-    if (std::getenv("GHOST_DEBUG")) {
-      std::map<std::int64_t, const skeleton::Skeleton*> p1;
-      for (const auto& f : s.fused) if (f.person_id == 1) p1[f.stamp_ns] = &f;
-      int k = 0;
-      for (const auto& f : s.fused) if (f.person_id == 2 && p1.count(f.stamp_ns) && k++ % 100 == 0) {
-        const auto& a = *p1[f.stamp_ns];
-        std::fprintf(stderr, "t %.2f torso1 %.2f %.2f %.2f torso2 %.2f %.2f %.2f sensors %x %x\n", f.stamp_ns*1e-9, a[skeleton::JointId::Torso].position.x(), a[skeleton::JointId::Torso].position.y(), a[skeleton::JointId::Torso].position.z(), f[skeleton::JointId::Torso].position.x(), f[skeleton::JointId::Torso].position.y(), f[skeleton::JointId::Torso].position.z(), a[skeleton::JointId::Torso].sensor_mask, f[skeleton::JointId::Torso].sensor_mask);
-      }
-    }
+  for (std::size_t n = 0; n < test.size(); ++n) {
+    const auto& s = test[n];
+    const auto& ev = spotted[n].events;
+    const auto& r = spotted[n].report;
     std::map<std::string, int> people;
     for (const auto& f : s.fused) ++people[std::to_string(f.person_id)];
     nlohmann::json tj = nlohmann::json::array();

@@ -131,6 +131,29 @@ std::vector<Clip> session_clips(const std::vector<SimSession>& sessions, const C
 
 namespace skelgraph::gesture {
 
+std::vector<SimSession> held_out_sessions(int sessions, std::uint64_t seed, const std::function<void(int, int)>& progress) {
+  std::vector<SimSession> out;
+  for (int i = 0; i < sessions; ++i) {
+    out.push_back(simulate_session((seed + 1) * 1000 + 500 + static_cast<std::uint64_t>(i)));
+    if (progress) progress(i + 1, sessions);
+  }
+  return out;
+}
+
+std::vector<SessionSpotting> spot_sessions(const Classifier& model, const std::vector<SimSession>& sessions,
+                                           const SpotterOptions& options) {
+  std::vector<SessionSpotting> out;
+  for (const auto& s : sessions) {
+    SessionSpotting r;
+    std::map<std::uint32_t, Spotter> spotters;  // one per fused person
+    for (const auto& f : s.fused)
+      for (const auto& e : spotters.try_emplace(f.person_id, model, options).first->second.step(f)) r.events.push_back(e);
+    r.report = score_spotting(r.events, s.truth, "point");
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
 ClassifierOptions sim_classifier_options() {
   ClassifierOptions c;
   c.features.set = FeatureSet::Thesis8;
@@ -152,20 +175,18 @@ Classifier train_on_sim(int sessions, std::uint64_t seed, const ClassifierOption
   auto model = Classifier::train(c, map, options);
   // The pointing correction: the median angles by which the spotted rays miss the true ones.
   std::vector<double> el, az;
-  for (const auto& s : train) {
-    std::map<std::uint32_t, Spotter> spotters;
-    for (const auto& f : s.fused)
-      for (const auto& e : spotters.try_emplace(f.person_id, model).first->second.step(f)) {
-        if (!e.has_ray) continue;
-        for (const auto& g : s.truth)
-          if (g.label == "point" && g.has_ray && e.end_ns >= g.start_ns - 500'000'000 && e.end_ns <= g.end_ns + 500'000'000) {
-            const auto off = ray_offset(e.ray_direction, g.ray_direction, e.out);
-            el.push_back(off.elevation);
-            az.push_back(off.azimuth_out);
-            break;
-          }
-      }
-  }
+  const auto spotted = spot_sessions(model, train);
+  for (std::size_t n = 0; n < train.size(); ++n)
+    for (const auto& e : spotted[n].events) {
+      if (!e.has_ray) continue;
+      for (const auto& g : train[n].truth)
+        if (g.label == "point" && g.has_ray && e.end_ns >= g.start_ns - 500'000'000 && e.end_ns <= g.end_ns + 500'000'000) {
+          const auto off = ray_offset(e.ray_direction, g.ray_direction, e.out);
+          el.push_back(off.elevation);
+          az.push_back(off.azimuth_out);
+          break;
+        }
+    }
   const auto median = [](std::vector<double> v) {
     if (v.empty()) return 0.0;
     std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());

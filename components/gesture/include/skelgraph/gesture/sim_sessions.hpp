@@ -37,6 +37,18 @@ ClassMap sim_class_map();
 // gesture bounds; the spotter cuts its own segments).
 ClassifierOptions sim_classifier_options();
 
+// Sessions the training never sees (seeds (seed + 1) * 1000 + 500 + i).
+std::vector<SimSession> held_out_sessions(int sessions, std::uint64_t seed,
+                                          const std::function<void(int done, int total)>& progress = {});
+
+// Each session spotted (one Spotter per fused person) and scored against its own truth.
+struct SessionSpotting {
+  std::vector<SpottedEvent> events;
+  SpottingReport report;
+};
+std::vector<SessionSpotting> spot_sessions(const Classifier& model, const std::vector<SimSession>& sessions,
+                                           const SpotterOptions& options = {});
+
 // A classifier trained on `sessions` simulated sessions (seeds seed*1000 + i),
 // and the clips it was trained on (count) for reports.
 Classifier train_on_sim(int sessions, std::uint64_t seed, const ClassifierOptions& options, std::size_t* clips = nullptr,
