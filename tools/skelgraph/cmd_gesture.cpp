@@ -33,6 +33,7 @@ struct GestureOptions {
   std::string hands = "canonical";
   bool no_trim = false;
   bool per_class = false;
+  bool prefixes = false;
   double reject_quantile = 0.02;
   int iterations = 100;
   std::uint64_t seed = 1;
@@ -71,6 +72,7 @@ ClassifierOptions classifier_options(const GestureOptions& o) {
   c.features.set = *feature_set_from_name(o.features);
   c.hands = *hands_from_name(o.hands);
   c.per_action = !o.per_class;
+  c.prefixes = o.prefixes;
   c.trimmed = !o.no_trim;
   c.reject_quantile = o.reject_quantile;
   c.threads = o.threads;
@@ -108,6 +110,7 @@ nlohmann::json config_json(const ClassifierOptions& c) {
           {"covariance", c.hmm.covariance == Covariance::Full ? "full" : "diag"},
           {"hands", hands_name(c.hands)},
           {"per_action", c.per_action},
+          {"prefixes", c.prefixes},
           {"trimmed", c.trimmed}};
 }
 
@@ -501,6 +504,7 @@ void add_model_options(CLI::App* c, GestureOptions& o) {
                 "canonical (default): mirror every clip so its more active arm is the right; augment: also train on mirrored "
                 "clips; as-is")
       ->check(CLI::IsMember({"canonical", "augment", "as-is"}));
+  c->add_flag("--prefixes", o.prefixes, "also train on each clip's first 50 % and 70 % (for spotting, which decides early)");
   c->add_flag("--per-class", o.per_class, "one model per class (the thesis) instead of one per recorded action");
   c->add_option("--reject-quantile", o.reject_quantile, "share of held-out training clips the rejection threshold may reject (default 0.02)")
       ->check(CLI::Range(0.0, 1.0));

@@ -66,6 +66,11 @@ Models train_models(const std::vector<const Clip*>& clips, const ClassMap& map, 
     auto& g = groups[{c->label, o.per_action ? c->action : std::string()}];
     g.push_back(prepared(c->x, o.hands, o.features.set));
     if (o.hands == Hands::Augment) g.push_back(mirrored(c->x, o.features.set));
+    if (o.prefixes)  // what a live spotter sees before the gesture ends
+      for (double share : {0.5, 0.7}) {
+        const auto n = static_cast<Eigen::Index>(share * static_cast<double>(c->x.rows()));
+        if (n >= 5) g.push_back(prepared(Sequence(c->x.topRows(n)), o.hands, o.features.set));
+      }
   }
   for (int k = 0; k < static_cast<int>(map.classes.size()); ++k)
     if (groups.lower_bound({k, std::string()}) == groups.end() || groups.lower_bound({k, std::string()})->first.first != k)

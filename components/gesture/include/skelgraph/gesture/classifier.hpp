@@ -62,6 +62,7 @@ struct ClassifierOptions {
   FeatureOptions features;
   Hands hands = Hands::Canonical;
   bool per_action = true;            // one model per recorded action; a class scores its best action model
+  bool prefixes = false;             // also train on each clip's first 50 % and 70 % (live spotting decides early)
   bool trimmed = true;               // the clips are cut to their motion_span (recorded in the model: classify the same way)
   double reject_quantile = 0.02;     // the threshold accepts this share less than all held-out training clips
   int calibration_folds = 3;         // held-out scores for the threshold come from this many inner folds (0: training scores)
