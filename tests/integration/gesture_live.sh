@@ -32,3 +32,12 @@ ok "live: $n pointing events with floor targets, read over DDS too"
 "$S" gesture sim --train-sessions 4 --test-sessions 2 --json >"$WORK/sim.json" 2>/dev/null || fail "gesture sim"
 json_check "$WORK/sim.json" 'd["spotting"]["truth"] == 12 and d["spotting"]["recall"] >= 0.8 and d["spotting"]["median_target_error_m"] < 0.4'
 ok "offline: held-out simulated sessions scored"
+
+# Parameters from the command line: surfaces as a comma-split list, and clear errors.
+"$S" run gesture -p model=sim -p surfaces=table:0,0.75,0,floor:0,0,0 --duration 0.5 >/dev/null 2>"$WORK/run.err" \
+  || fail "run gesture with two surfaces: $(tail -3 "$WORK/run.err")"
+"$S" run gesture -p model=sim -p surfaces=table:0,0.75 --duration 0.5 2>"$WORK/bad.err" && fail "a surface with two numbers was accepted"
+grep -q "surface 'table:0,0.75': expected x,y,z" "$WORK/bad.err" || fail "surface error: $(cat "$WORK/bad.err")"
+"$S" run gesture --duration 0.5 2>"$WORK/bad.err" && fail "no model was accepted"
+grep -q "model: no classifier given" "$WORK/bad.err" || fail "missing model error: $(cat "$WORK/bad.err")"
+ok "command-line surfaces and clear errors for bad parameters"

@@ -71,7 +71,14 @@ GestureComponent::GestureComponent(runtime::Context& ctx, const runtime::Params&
   options_.hold = params.get<double>("hold_s");
   options_.still_speed = params.get<double>("still_speed");
   options_.surfaces.clear();
-  for (const auto& s : params.get<std::vector<std::string>>("surfaces")) options_.surfaces.push_back(parse_surface(s));
+  // On a command line a list is split at commas, which also splits "name:x,y,z":
+  // a piece without a name (no ':') continues the one before it.
+  std::vector<std::string> surfaces;
+  for (const auto& piece : params.get<std::vector<std::string>>("surfaces")) {
+    if (piece.find(':') == std::string::npos && !surfaces.empty()) surfaces.back() += "," + piece;
+    else surfaces.push_back(piece);
+  }
+  for (const auto& s : surfaces) options_.surfaces.push_back(parse_surface(s));
   const auto& labels = classifier_.labels();
   if (std::find(labels.begin(), labels.end(), options_.point_label) == labels.end())
     spdlog::warn("{}: the classifier has no class '{}': no pointing rays will be given", ctx_.name(), options_.point_label);
