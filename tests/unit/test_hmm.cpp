@@ -283,6 +283,9 @@ TEST(Features, AnglesToTheVerticalAndSpeedsOverTheRealInterval) {
   EXPECT_NEAR(x(3), M_PI / 2 - 0.1, 1e-9);
   EXPECT_NEAR(x(7), 2.0, 1e-6);
   EXPECT_NEAR(x(6), 0.0, 1e-9);
+  // 1 ms later another 0.1 rad: the interval counts as min_interval (20 ms), so 5 rad/s, not 100.
+  x = fs.step(pose(e, e + 0.3 * Eigen::Vector3d(0, std::sin(0.2), -std::cos(0.2)), 51'000'000));
+  EXPECT_NEAR(x(7), 5.0, 1e-6);
 }
 
 TEST(Features, MissingJointsAreHeldAndMarked) {

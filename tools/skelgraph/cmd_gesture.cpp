@@ -307,7 +307,7 @@ int gesture_spot(const GestureOptions& o) {
         f.stamp_ns = t;
         stream.push_back(f);
       }
-      t0 = last + gap;
+      t0 = stream.back().stamp_ns + 33'333'333;  // the next clip one frame after the rest
     }
     Spotter spotter(model, o.spot);
     std::vector<SpottedEvent> events;

@@ -209,7 +209,7 @@ VectorXd FeatureStream::step(const skeleton::Skeleton& s, bool* complete, Vector
   if (raw) *raw = a;
   bool all = true;
   double dt = last_dt_;
-  if (!first_ && s.stamp_ns > last_ns_) dt = static_cast<double>(s.stamp_ns - last_ns_) * 1e-9;
+  if (!first_ && s.stamp_ns > last_ns_) dt = std::max(o_.min_interval, static_cast<double>(s.stamp_ns - last_ns_) * 1e-9);
   VectorXd out(size());
   for (int i = 0; i < values_; ++i) {
     const auto iu = static_cast<std::size_t>(i);

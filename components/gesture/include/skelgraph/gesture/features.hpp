@@ -21,7 +21,8 @@
 // confidence keeps that angle's last good value (its speed is then 0) and is
 // marked incomplete; frames before the first good value take the first good
 // one (batch) or 0 until one comes (live). Frames whose stamps do not
-// increase use the previous interval.
+// increase use the previous interval; intervals shorter than min_interval
+// count as min_interval.
 
 #include <optional>
 #include <string>
@@ -39,6 +40,7 @@ enum class FeatureSet { Thesis8, Extended, Body };
 struct FeatureOptions {
   FeatureSet set = FeatureSet::Thesis8;
   float min_confidence = skeleton::kTracked;
+  double min_interval = 0.02;  // s: speeds are taken over at least this long (frames 1 ms apart would make noise huge)
 };
 
 std::vector<std::string> feature_names(FeatureSet set);
