@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# Pointing live, measured: runs bringup/gesture_sim.yaml (simulated cell ->
+# Kalman fusion -> gesture) for SECONDS (default 60) in a loopback-only
+# network namespace, records every gesture event and the ground-truth
+# skeletons over DDS with `skelgraph topic echo`, and scores each pointing
+# event's floor target against where the true shoulder -> hand ray of the
+# same arm meets the floor at the event's stamp. JSON on stdout: per event
+# the error, and the median. Needs root for `unshare -n`.
+# Usage: bench/gesture_live.sh BUILD_DIR [SECONDS]
+set -euo pipefail
+build=${1:?usage: gesture_live.sh BUILD_DIR [SECONDS]}
+seconds=${2:-60}
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+sg="$build/bin/skelgraph"
+unshare -n bash -c '
+  set -e
+  ip link set lo up
+  cd "$1"
+  "$2" topic echo skelgraph/skeleton/truth --json --timeout 120 >"$3/truth.json" & tp=$!
+  "$2" topic echo skelgraph/gesture/event --json --timeout 120 >"$3/events.json" & ep=$!
+  "$2" launch bringup/gesture_sim.yaml --duration "$4" >"$3/launch.json" 2>"$3/launch.err"
+  sleep 1
+  kill $tp $ep 2>/dev/null || true
+' _ "$root" "$sg" "$work" "$seconds"
+python3 - "$work" "$seconds" <<'PY'
+import bisect, json, math, statistics, sys
+work, seconds = sys.argv[1], float(sys.argv[2])
+truth = [json.loads(l)["data"] for l in open(work + "/truth.json") if l.strip()]
+events = [json.loads(l)["data"] for l in open(work + "/events.json") if l.strip()]
+stamps = [t["stamp_ns"] for t in truth]
+def joint(t, name):
+    p = next(j["position"] for j in t["joints"] if j["name"] == name)
+    return (p["x"], p["y"], p["z"])
+out, errors = [], []
+for e in events:
+    row = {"label": e["label"], "arm": e["arm"], "confidence": e["confidence"], "has_target": e["has_target"]}
+    if e["label"] == "point" and e["has_target"] and truth:
+        i = min(range(len(stamps)), key=lambda k: abs(stamps[k] - e["end_stamp_ns"]))
+        sh, ha = joint(truth[i], e["arm"] + "_shoulder"), joint(truth[i], e["arm"] + "_hand")
+        d = [b - a for a, b in zip(sh, ha)]
+        if d[1] < 0:
+            k = -sh[1] / d[1]
+            tt = [a + k * b for a, b in zip(sh, d)]
+            err = math.dist(tt, [e["target"]["x"], e["target"]["y"], e["target"]["z"]])
+            row.update(true_target=tt, target=[e["target"][c] for c in "xyz"], error_m=err)
+            errors.append(err)
+    out.append(row)
+print(json.dumps({"seconds": seconds, "events": len(events), "scored": len(errors),
+                  "median_target_error_m": statistics.median(errors) if errors else None,
+                  "within_15_cm": sum(e <= 0.15 for e in errors), "per_event": out}, indent=2))
+PY
