@@ -187,12 +187,7 @@ Classifier train_on_sim(int sessions, std::uint64_t seed, const ClassifierOption
           break;
         }
     }
-  const auto median = [](std::vector<double> v) {
-    if (v.empty()) return 0.0;
-    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-    return v[v.size() / 2];
-  };
-  model.set_pointing_correction({median(el), median(az)});
+  if (!el.empty()) model.set_pointing_correction({median(el), median(az)});
   return model;
 }
 

@@ -15,13 +15,14 @@ constexpr JointId kArm[2][3] = {{JointId::LeftShoulder, JointId::LeftElbow, Join
                                 {JointId::RightShoulder, JointId::RightElbow, JointId::RightHand}};
 constexpr const char* kSideName[2] = {"left", "right"};
 
+}  // namespace
+
 double median(std::vector<double> v) {
   if (v.empty()) return std::nan("");
   std::sort(v.begin(), v.end());
   const std::size_t n = v.size();
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
-}  // namespace
 
 const char* motion_state_name(MotionState s) {
   switch (s) {
