@@ -57,5 +57,6 @@ void add_eval_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_fuse_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_calib_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_gesture_command(CLI::App& app, GlobalOptions& g, Action& run);
+void add_oni_command(CLI::App& app, GlobalOptions& g, Action& run);  // with SKELGRAPH_WITH_OPENNI2
 
 }  // namespace skelgraph::cli

@@ -115,6 +115,9 @@ int main(int argc, char** argv) {
   add_calib_command(app, g, run);
   add_gesture_command(app, g, run);
   add_fuse_command(app, g, run);
+#ifdef SKELGRAPH_WITH_OPENNI2
+  add_oni_command(app, g, run);
+#endif
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

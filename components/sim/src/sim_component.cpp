@@ -6,6 +6,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "skelgraph/depth/depth_msg.hpp"
 #include "skelgraph/skeleton/skeleton_msg.hpp"
 
 namespace skelgraph::sim {
@@ -23,6 +24,13 @@ void add_sim_params(runtime::ParamSchema& schema) {
       .add_double("truth_rate", 30.0, "ground-truth rate, Hz", 1.0, 1000.0)
       .add_double("drop_probability", 0.01, "chance that a sensor frame is lost", 0.0, 0.9)
       .add_double("jitter_ms", 2.0, "sd of sensor frame timing, ms", 0.0, 20.0);
+}
+
+calib::Intrinsics parse_depth_size(const std::string& size) {
+  for (const auto& [name, w, h] : {std::tuple{"160x120", 160, 120}, {"320x240", 320, 240}, {"640x480", 640, 480}}) {
+    if (size == name) return depth::kinect_intrinsics(w, h);
+  }
+  throw std::invalid_argument("depth_size '" + size + "': expected 160x120, 320x240 or 640x480");
 }
 
 SimConfig sim_config_from(const runtime::Params& params) {
@@ -63,6 +71,10 @@ runtime::ComponentInfo SimComponent::describe() {
       .add_string_list("publish_sensors", {}, "publish only these sensors' skeletons and poses (default: all); "
                                               "with wall_clock_aligned, several sims can each play some sensors of one cell")
       .add_bool("publish_truth", true, "publish ground truth")
+      .add_bool("publish_raw", true, "publish the simulated trackers' skeletons (off: a depth tracker makes them from the depth images)")
+      .add_bool("depth", false, "render each sensor's depth image (people, props, floor, walls) and publish it on skelgraph/depth")
+      .add_string("depth_size", "320x240", "depth image size", {"160x120", "320x240", "640x480"})
+      .add_bool("depth_noise", true, "Kinect-like depth errors: disparity noise and quantisation, drop-outs, missing edges")
       .add_bool("publish_poses", true, "publish the sensors' true poses (off: a calibration file or component provides them)")
       .add_bool("wall_clock_aligned", false,
                 "scenario time = wall clock modulo the scenario's duration, so sims started at different times (or "
@@ -87,6 +99,18 @@ SimComponent::SimComponent(runtime::Context& ctx, const runtime::Params& params)
     }
   }
   publish_truth_ = params.get<bool>("publish_truth");
+  publish_raw_ = params.get<bool>("publish_raw");
+  if (params.get<bool>("depth")) {
+    const auto k = parse_depth_size(params.get<std::string>("depth_size"));
+    DepthNoise noise;
+    noise.enabled = params.get<bool>("depth_noise");
+    const Rng base(config_.scenario.seed);
+    for (std::size_t i = 0; i < config_.sensors.size(); ++i) {
+      renderers_.emplace_back(config_.sensors[i], k, noise);
+      depth_rngs_.push_back(base.fork(0xde97000 + i));
+    }
+    depth_pub_ = std::make_unique<runtime::Publisher<msg::DepthFrame>>(ctx, runtime::topics::kDepth);
+  }
   publish_poses_ = params.get<bool>("publish_poses");
   aligned_ = params.get<bool>("wall_clock_aligned");
 }
@@ -143,7 +167,8 @@ void SimComponent::tick() {
       f.frame_number(e.skeleton.frame_number);
       f.people(e.people);
       frame_pub_.publish(f);
-    } else {
+      if (depth_pub_) publish_depth(e);
+    } else if (publish_raw_) {
       raw_pub_.publish(skeleton::to_msg(e.skeleton));
       ++raw_published_;
     }
@@ -160,6 +185,16 @@ void SimComponent::tick() {
   finished_ = true;
   timer_.cancel();
   ctx_.set_health(runtime::HealthState::Ok, "finished");
+}
+
+void SimComponent::publish_depth(const SimEvent& frame) {
+  const double t = frame.t;  // the frame's capture time on the world clock
+  auto image = renderers_[frame.sensor].render(sim_->truth_at(t), sim_->scenario().at(t).obstacles,
+                                               depth_rngs_[frame.sensor], config_.scenario.height);
+  image.stamp_ns = frame.skeleton.stamp_ns;
+  image.frame_number = frame.skeleton.frame_number;
+  depth_pub_->publish(depth::to_msg(std::move(image)));
+  ++depth_published_;
 }
 
 nlohmann::json SimComponent::details() const {
@@ -179,6 +214,7 @@ nlohmann::json SimComponent::details() const {
           {"sensors", sensors},
           {"truth_published", truth_published_},
           {"raw_published", raw_published_},
+          {"depth_published", depth_published_},
           {"runs_completed", runs_completed_},
           {"finished", finished_.load()}};
 }
@@ -188,6 +224,7 @@ std::string SimComponent::summary() const {
   os << config_.scenario.name << " (" << config_.profile << ", seed " << config_.scenario.seed << "): "
      << truth_published_ << " truth and " << raw_published_ << " raw skeletons from " << config_.sensors.size()
      << " sensor(s)";
+  if (depth_pub_) os << ", " << depth_published_ << " depth images";
   if (runs_completed_ > 0) os << ", " << runs_completed_ << " run(s) completed";
   return os.str();
 }

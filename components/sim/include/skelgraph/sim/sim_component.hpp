@@ -2,13 +2,15 @@
 // `sim` component: runs the virtual work cell in real time (or a multiple of
 // it) and publishes ground truth on skelgraph/skeleton/truth (world frame),
 // each virtual sensor's tracker output on skelgraph/skeleton/raw (sensor frame,
-// sensor clock) and the sensors' true poses on skelgraph/calibration.
+// sensor clock) and the sensors' true poses on skelgraph/calibration; with
+// `depth`, also each sensor's depth image on skelgraph/depth (depth_render.hpp).
 
 #include <atomic>
 #include <memory>
 
 #include "skelgraph/runtime/component.hpp"
 #include "skelgraph/runtime/pubsub.hpp"
+#include "skelgraph/sim/depth_render.hpp"
 #include "skelgraph/sim/simulation.hpp"
 
 namespace skelgraph::sim {
@@ -36,14 +38,18 @@ class SimComponent final : public runtime::Component {
   runtime::Publisher<msg::Skeleton> truth_pub_, raw_pub_;
   runtime::Publisher<msg::SensorFrame> frame_pub_;
   runtime::Publisher<msg::SensorPose> pose_pub_;
+  std::unique_ptr<runtime::Publisher<msg::DepthFrame>> depth_pub_;  // with `depth`
+  std::vector<DepthRenderer> renderers_;                             // per sensor, with `depth`
+  std::vector<Rng> depth_rngs_;
   runtime::TimerHandle timer_;
   std::int64_t start_mono_ns_ = 0;
   std::vector<std::string> publish_sensors_;  // empty: all
-  bool publish_truth_ = true, publish_poses_ = true, aligned_ = false;
+  bool publish_truth_ = true, publish_poses_ = true, publish_raw_ = true, aligned_ = false;
+  void publish_depth(const SimEvent& frame);
   double skip_before_s_ = 0.0;  // aligned start: events before this were "published" before we started
   bool publishes(std::size_t sensor) const;
   double loop_offset_s_ = 0.0;  // world time at which the current run started
-  std::uint64_t truth_published_ = 0, raw_published_ = 0, runs_completed_ = 0;
+  std::uint64_t truth_published_ = 0, raw_published_ = 0, depth_published_ = 0, runs_completed_ = 0;
   std::atomic<bool> finished_{false};
 };
 
@@ -52,5 +58,7 @@ class SimComponent final : public runtime::Component {
 SimConfig sim_config_from(const runtime::Params& params);
 // The parameters both take.
 void add_sim_params(runtime::ParamSchema& schema);
+// "WxH" -> Kinect-like intrinsics of that size; throws std::invalid_argument naming the accepted sizes.
+calib::Intrinsics parse_depth_size(const std::string& size);
 
 }  // namespace skelgraph::sim

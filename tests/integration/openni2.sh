@@ -1,0 +1,70 @@
+#!/usr/bin/env bash
+# The OpenNI2 path on the Dummy device: live depth at 30 Hz on skelgraph/depth;
+# sync sessions recorded to .oni; Debian's player delivering no frame of an
+# unmended Dummy recording (pinned), `oni mend` fixing it; recordings played
+# back frame for frame by the component; clear errors for bad URIs.
+source "$(dirname "$0")/lib.sh"
+
+# 1. Live, with a sync master: two sessions recorded (the first left unmended on purpose).
+# The launch file as users run it (recordings/oni relative to where it runs: here $WORK), beside a second Dummy
+# device that leaves its recordings unmended.
+(cd "$WORK" && exec "$SKELGRAPH" launch "$SRC/bringup/openni2_dummy.yaml" --duration 14 --json) >"$WORK/live.json" 2>"$WORK/live.err" &
+live=$!
+"$SKELGRAPH" run openni2 --name raw_rec -p sensor_id=depth2 -p record_directory="$WORK/raw" -p mend_recordings=false \
+  --duration 14 --json >"$WORK/raw.json" 2>"$WORK/raw.err" &
+raw=$!
+"$SKELGRAPH" topic hz skelgraph/depth --json --window 3 --timeout 10 >"$WORK/hz.json" 2>"$WORK/hz.err" || fail "no depth: $(cat "$WORK/hz.err")"
+# Two Dummy devices publish: ~60 Hz together.
+json_check "$WORK/hz.json" '50 < d["rate_hz"] < 70'
+"$SKELGRAPH" topic echo skelgraph/depth --count 1 --json --timeout 5 >"$WORK/echo.json"
+json_check "$WORK/echo.json" 'd["data"]["width"] == 320 and d["data"]["height"] == 240 and d["data"]["depth_mm_count"] == 76800 and d["data"]["depth_mm_valid"] > 300'
+"$SKELGRAPH" sync start --label oni --timeout 10 >/dev/null || fail "sync start"
+sleep 3
+"$SKELGRAPH" sync stop --timeout 10 >/dev/null || fail "sync stop"
+wait "$live" || fail "launch: $(tail -5 "$WORK/live.err")"
+wait "$raw" || fail "raw recorder: $(tail -5 "$WORK/raw.err")"
+ok "live Dummy depth at $(json_get "$WORK/hz.json" 'round(d["rate_hz"], 1)') Hz from two devices"
+
+mended=$(ls "$WORK"/recordings/oni/depth1_session*.oni 2>/dev/null | tail -1)
+[ -n "$mended" ] || fail "no recording in recordings/oni: $(cat "$WORK/live.json")"
+mv "$mended" "$WORK/mended.oni"
+unmended=$(ls "$WORK"/raw/depth2_session*.oni | tail -1)
+
+# 2. Debian's OniFile player drops every frame of the unmended file: pinned.
+if "$SKELGRAPH" oni info "$unmended" --read >"$WORK/u.out" 2>"$WORK/u.err"; then
+  fail "an unmended Dummy recording played ($(cat "$WORK/u.out")): OpenNI2 changed, update components/openni2/README.md"
+fi
+grep -q "no frame came" "$WORK/u.err" || fail "unexpected error: $(cat "$WORK/u.err")"
+"$SKELGRAPH" oni mend "$unmended" --json >"$WORK/mend.json"
+json_check "$WORK/mend.json" 'd[0]["streams_mended"] == 1'
+"$SKELGRAPH" oni mend "$unmended" --json >"$WORK/mend2.json"
+json_check "$WORK/mend2.json" 'd[0]["streams_mended"] == 0'
+for f in "$unmended" "$WORK/mended.oni"; do
+  "$SKELGRAPH" oni info "$f" --read --json >"$WORK/info.json" || fail "info $f"
+  # About 3 s at 30 Hz, every frame read back, the Dummy's pattern in it.
+  json_check "$WORK/info.json" '60 <= d["frames"] <= 150 and d["frames_read"] == d["frames"] and d["valid_fraction"] > 0.004'
+done
+frames=$(json_get "$WORK/info.json" 'd["frames"]')
+ok "recorded $frames frames; unmended file plays nothing (pinned), mended plays all"
+
+# 3. Playback through the component: as fast as possible, then in real time.
+"$SKELGRAPH" run openni2 -p uri="$WORK/mended.oni" -p speed=0 --duration 30 --json >"$WORK/play.json" 2>"$WORK/play.err" || fail "play: $(cat "$WORK/play.err")"
+json_check "$WORK/play.json" 'd["components"][0]["details"]["published"] == d["components"][0]["details"]["frames_in_recording"] == '"$frames"' and d["duration_s"] < 10'
+start=$SECONDS
+"$SKELGRAPH" run openni2 -p uri="$WORK/mended.oni" --duration 30 --json >"$WORK/play1.json" 2>"$WORK/play1.err" || fail "play: $(cat "$WORK/play1.err")"
+json_check "$WORK/play1.json" 'abs(d["duration_s"] - '"$frames"' / 30.0) < 1.5'
+ok "played back $frames frames fast and in $(json_get "$WORK/play1.json" 'round(d["duration_s"], 1)') s at speed 1"
+
+# 4. Errors a user can act on.
+if "$SKELGRAPH" run openni2 -p uri=Dumy --duration 1 >/dev/null 2>"$WORK/e1"; then fail "bad URI accepted"; fi
+grep -q "cannot open 'Dumy'" "$WORK/e1" || fail "bad URI message: $(cat "$WORK/e1")"
+if "$SKELGRAPH" run openni2 -p uri="$WORK/none.oni" --duration 1 >/dev/null 2>"$WORK/e2"; then fail "missing file accepted"; fi
+grep -q "no recording" "$WORK/e2" || fail "missing file message: $(cat "$WORK/e2")"
+if "$SKELGRAPH" run openni2 -p uri="$WORK/mended.oni" -p record_directory="$WORK/x" --duration 1 >/dev/null 2>"$WORK/e3"; then
+  fail "recording a recording accepted"
+fi
+grep -q "record_directory is for devices" "$WORK/e3" || fail "record message: $(cat "$WORK/e3")"
+echo "garbage" >"$WORK/bad.oni"
+if "$SKELGRAPH" oni mend "$WORK/bad.oni" 2>"$WORK/e4"; then fail "garbage mended"; fi
+grep -q "not an OpenNI recording" "$WORK/e4" || fail "garbage message: $(cat "$WORK/e4")"
+ok "errors name the problem"
