@@ -13,6 +13,8 @@
 
 #include "cli.hpp"
 #include "eval_sim.hpp"
+#include "skelgraph/depth_tracker/sim_depth.hpp"
+#include "skelgraph/sim/sim_component.hpp"
 #include "report.hpp"
 #include "skelgraph/calib/calib_file.hpp"
 #include "skelgraph/eval/offline.hpp"
@@ -405,17 +407,36 @@ int eval_sim(const SimEvalOptions& o) {
     } catch (const std::invalid_argument& e) {
       throw UsageError(e.what());
     }
-    sim::Simulation sim(cfg);
     std::map<std::string, Eigen::Isometry3d> poses;
     for (const auto& s : cfg.sensors) poses[s.id] = s.world_from_sensor();
     std::vector<eval::TimedSkeleton> events;
-    for (auto& e : sim.advance(sim.duration() + 1.0)) {
-      const auto t = cfg.epoch_ns + static_cast<std::int64_t>(std::llround(e.t * 1e9));
-      events.push_back({e.kind == sim::SimEvent::Kind::Truth ? eval::TimedSkeleton::Kind::Truth
-                                                              : eval::TimedSkeleton::Kind::Raw,
-                        t, std::move(e.skeleton)});
-    }
     const bool progress = !o.json && !o.quiet;
+    nlohmann::json depth_info;
+    if (o.source == "depth") {
+      depth_tracker::SimDepthOptions dopt;
+      dopt.girth = o.girth;
+      try {
+        dopt.intrinsics = sim::parse_depth_size(o.depth_size);
+      } catch (const std::invalid_argument& e) {
+        throw UsageError(e.what());
+      }
+      if (progress) std::fprintf(stderr, "\rrendering and tracking depth for %s...      ", scenario.c_str());
+      auto d = depth_tracker::track_simulated_depth(cfg, dopt);
+      events = std::move(d.events);
+      depth_info = {{"frames", d.frames},
+                    {"size", o.depth_size},
+                    {"girth", o.girth},
+                    {"render_ms_per_frame", d.frames ? 1e3 * d.render_s / d.frames : 0.0},
+                    {"track_ms_per_frame", d.frames ? 1e3 * d.track_s / d.frames : 0.0}};
+    } else {
+      sim::Simulation sim(cfg);
+      for (auto& e : sim.advance(sim.duration() + 1.0)) {
+        const auto t = cfg.epoch_ns + static_cast<std::int64_t>(std::llround(e.t * 1e9));
+        events.push_back({e.kind == sim::SimEvent::Kind::Truth ? eval::TimedSkeleton::Kind::Truth
+                                                                : eval::TimedSkeleton::Kind::Raw,
+                          t, std::move(e.skeleton)});
+      }
+    }
     if (progress) std::fprintf(stderr, "\revaluating %s (%zu events)...      ", scenario.c_str(), events.size());
     const auto r = eval::evaluate(poses, events, eo);
     if (progress) std::fprintf(stderr, "\r%50s\r", "");
@@ -424,9 +445,17 @@ int eval_sim(const SimEvalOptions& o) {
     nlohmann::json streams = nlohmann::json::array();
     for (const auto& s : r.streams) streams.push_back(stream_json(s));
     out.push_back({{"scenario", scenario}, {"sensors", cfg.sensors.size()}, {"profile", cfg.profile},
-                   {"seed", cfg.scenario.seed}, {"ticks", r.ticks}, {"streams", streams}});
-    const std::string title = scenario + " (" + std::to_string(cfg.sensors.size()) + " sensors, " + cfg.profile +
-                              ", seed " + std::to_string(cfg.scenario.seed) + ")";
+                   {"seed", cfg.scenario.seed}, {"ticks", r.ticks}, {"streams", streams}, {"source", o.source}});
+    if (!depth_info.is_null()) out.back()["depth"] = depth_info;
+    const std::string title =
+        scenario + " (" + std::to_string(cfg.sensors.size()) + " sensors, " +
+        (o.source == "depth" ? "depth tracker on " + o.depth_size + " depth" : cfg.profile) + ", seed " +
+        std::to_string(cfg.scenario.seed) + ")";
+    if (!depth_info.is_null() && !o.json && !o.quiet) {
+      std::printf("\n%llu depth images: rendering %.1f ms, tracking %.1f ms per image (one thread)\n",
+                  static_cast<unsigned long long>(depth_info["frames"].get<std::uint64_t>()),
+                  depth_info["render_ms_per_frame"].get<double>(), depth_info["track_ms_per_frame"].get<double>());
+    }
     if (!o.json && !o.quiet) print_table(title, r);
     if (eo.trace) html += report_section(o.report_dir, scenario, title, r, "right_hand");
   }
@@ -481,6 +510,13 @@ void add_eval_command(CLI::App& app, GlobalOptions&, Action& run) {
   s->add_option("--scenarios", o->scenarios, "scenarios to run (default: the thesis's seven)")->delimiter(',');
   add_fusion_options(s, o->methods, o->delay_ms, o->max_age_ms, "fusion methods (default: all)");
   s->add_flag("--json", o->json, "machine-readable results");
+  s->add_option("--source", o->source,
+                "raw skeletons from: tracker (the simulator's tracker model) or depth (rendered depth images through "
+                "the open depth tracker)")
+      ->check(CLI::IsMember({"tracker", "depth"}));
+  s->add_option("--depth-size", o->depth_size, "depth: image size (160x120, 320x240, 640x480)");
+  s->add_option("--girth", o->girth, "depth: the simulated people's build (1: the renderer's standard; 0.85 slim, 1.25 stout)")
+      ->check(CLI::Range(0.5, 2.0));
   s->add_option("--report", o->report_dir, "also write DIR/report.html (tables, inline SVG plots) and each plot as SVG");
   s->callback([o, &run] { run = [o] { return eval_sim(*o); }; });
 

@@ -12,6 +12,11 @@ struct SimEvalOptions {
   // -p NAME=VALUE for the simulator; the scenarios to run; fusion methods (empty: all)
   std::vector<std::string> params, scenarios{"walk", "360", "hide", "box", "occ", "sit", "arms"}, methods;
   double delay_ms = 0, max_age_ms = 100;
+  // Where the raw skeletons come from: "tracker" (the simulator's tracker
+  // model) or "depth" (rendered depth images through the open depth tracker).
+  std::string source = "tracker";
+  std::string depth_size = "320x240";
+  double girth = 1.1;  // depth: the simulated people's build against the tracker's standard model
   bool json = false;
   bool quiet = false;  // nothing on stdout (progress still on stderr)
   std::string report_dir;

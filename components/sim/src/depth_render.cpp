@@ -9,12 +9,13 @@ namespace skelgraph::sim {
 
 using skeleton::JointId;
 
-std::vector<Capsule> body_capsules(const skeleton::Skeleton& s, double height_m) {
-  const double k = height_m / 1.75;
+std::vector<Capsule> body_capsules(const skeleton::Skeleton& s, double height_m, double girth) {
+  const double k = height_m / 1.75 * girth;
+  const double head_k = height_m / 1.75;
   const auto p = [&](JointId j) { return s[j].position; };
   const Eigen::Vector3d hip_centre = 0.5 * (p(JointId::LeftHip) + p(JointId::RightHip));
   std::vector<Capsule> c = {
-      {p(JointId::Head), p(JointId::Head), 0.095 * k},
+      {p(JointId::Head), p(JointId::Head), 0.095 * head_k},
       {p(JointId::Neck), p(JointId::Head), 0.055 * k},
       {p(JointId::LeftShoulder), p(JointId::RightShoulder), 0.06 * k},
       {p(JointId::LeftShoulder), p(JointId::LeftHip), 0.085 * k},
@@ -119,7 +120,8 @@ DepthRenderer::DepthRenderer(const SensorConfig& sensor, const calib::Intrinsics
 }
 
 std::vector<float> DepthRenderer::render_exact(const std::vector<skeleton::Skeleton>& people,
-                                               const std::vector<Obstacle>& obstacles, double height_m) const {
+                                               const std::vector<Obstacle>& obstacles, double height_m,
+                                               double girth) const {
   const int w = k_.width, h = k_.height;
   std::vector<double> zbuf(rays_.size(), kInf);
   const Eigen::Isometry3d world_from_sensor = view_.config().world_from_sensor();
@@ -142,7 +144,7 @@ std::vector<float> DepthRenderer::render_exact(const std::vector<skeleton::Skele
   // People: each capsule only over the pixels its end spheres can cover.
   const Eigen::Isometry3d sensor_from_world = view_.sensor_from_world();
   for (const auto& person : people) {
-    for (auto cap : body_capsules(person, height_m)) {
+    for (auto cap : body_capsules(person, height_m, girth)) {
       cap.a = sensor_from_world * cap.a;
       cap.b = sensor_from_world * cap.b;
       int u0 = 0, u1 = w - 1, v0 = 0, v1 = h - 1;
@@ -181,8 +183,9 @@ std::vector<float> DepthRenderer::render_exact(const std::vector<skeleton::Skele
 }
 
 depth::DepthImage DepthRenderer::render(const std::vector<skeleton::Skeleton>& people,
-                                        const std::vector<Obstacle>& obstacles, Rng& rng, double height_m) const {
-  const auto exact = render_exact(people, obstacles, height_m);
+                                        const std::vector<Obstacle>& obstacles, Rng& rng, double height_m,
+                                        double girth) const {
+  const auto exact = render_exact(people, obstacles, height_m, girth);
   auto image = depth::DepthImage::blank(k_);
   image.sensor_id = view_.config().id;
   const int w = k_.width, h = k_.height;

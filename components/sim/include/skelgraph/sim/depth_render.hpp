@@ -36,8 +36,9 @@ struct Capsule {
 };
 
 // The body's volume around a (true, world-frame) skeleton, scaled by body
-// height: head, neck, trunk, arms, hands, legs as capsules.
-std::vector<Capsule> body_capsules(const skeleton::Skeleton& skeleton, double height_m = 1.75);
+// height: head, neck, trunk, arms, hands, legs as capsules. `girth` scales
+// every radius but the head's (builds differ: 0.85 slim .. 1.25 stout).
+std::vector<Capsule> body_capsules(const skeleton::Skeleton& skeleton, double height_m = 1.75, double girth = 1.0);
 
 struct Room {
   bool enabled = true;
@@ -52,10 +53,10 @@ class DepthRenderer {
   // The depth image of the scene: people (world-frame truth skeletons), props
   // and room. sensor_id is set; stamp and frame number are the caller's.
   depth::DepthImage render(const std::vector<skeleton::Skeleton>& people, const std::vector<Obstacle>& obstacles,
-                           Rng& rng, double height_m = 1.75) const;
+                           Rng& rng, double height_m = 1.75, double girth = 1.0) const;
   // The same without noise, drop-outs or range limits other than the room: exact depth in metres (0: nothing).
   std::vector<float> render_exact(const std::vector<skeleton::Skeleton>& people, const std::vector<Obstacle>& obstacles,
-                                  double height_m = 1.75) const;
+                                  double height_m = 1.75, double girth = 1.0) const;
 
   const calib::Intrinsics& intrinsics() const { return k_; }
   const SensorView& view() const { return view_; }

@@ -1,0 +1,80 @@
+#pragma once
+// Open skeleton tracking from depth (no DDS): people found in a depth image
+// as person-shaped regions above the floor, and the 15-joint body model
+// fitted to each person's points frame by frame, starting from the previous
+// pose.
+//
+// The model is a set of capsules (head, neck, trunk, arms, hands, legs) hung
+// on the joints; the fit moves the 15 joints (45 unknowns) to minimise, by
+// Gauss-Newton, the distance of each point to the surface of its nearest
+// capsule (robust: far points are ignored, mid ones down-weighted), plus the
+// deviation of bone lengths (and the trunk's shape) from the person's, plus
+// a pull towards the previous pose. A new person starts from a standing
+// template facing the sensor, scaled to the height of their region; a person
+// not seen for `lost_after_s` is dropped and starts again when found.
+// Per-joint confidence: 1 when enough points support the joint's segments,
+// 0.5 (inferred) when not.
+//
+// Frames: the image's sensor frame (skeletons are reported in it, like any
+// tracker's), and a world frame with y up and the floor at y = 0, given by the
+// sensor's pose (set_pose; default: a level sensor 1.2 m above the floor).
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "skelgraph/depth/depth_image.hpp"
+#include "skelgraph/skeleton/skeleton.hpp"
+
+namespace skelgraph::depth_tracker {
+
+struct TrackerOptions {
+  double voxel_m = 0.03;           // the person's points are thinned to one per cube of this side
+  int iterations = 6;              // Gauss-Newton steps per frame
+  int init_iterations = 30;        // ... for a new person
+  double floor_margin_m = 0.05;    // points this close above the floor are floor
+  double max_step_m = 0.08;        // neighbouring pixels further apart in depth belong to different regions
+  double min_height_m = 0.9, max_height_m = 2.4;  // a person's region: top above the floor
+  double min_extent_m = 0.8;       // ... and vertical extent (legs may be out of view)
+  double max_width_m = 2.2;        // ... and horizontal extent (arms spread: about the height)
+  std::size_t min_points = 60;     // ... and points after thinning
+  double outlier_m = 0.15;         // points farther than this from the model's surface are ignored
+  double bone_weight = 30.0;       // per bone, against one point
+  double smooth_weight = 0.5;      // per joint, pull towards the previous frame's pose
+  double match_radius_m = 0.7;     // a region continues a person whose pelvis was this close
+  double lost_after_s = 0.5;
+  double tracked_support = 8;      // points on a joint's segments for confidence 1
+};
+
+struct TrackerStats {
+  std::uint64_t frames = 0, regions = 0, people_reported = 0, initialisations = 0;
+  double mean_points = 0.0;       // per reported person
+  double mean_residual_m = 0.0;   // mean |distance to surface| of inlying points, last frame
+};
+
+class DepthTracker {
+ public:
+  explicit DepthTracker(TrackerOptions options = {});
+  ~DepthTracker();
+  DepthTracker(DepthTracker&&) noexcept;
+  DepthTracker& operator=(DepthTracker&&) noexcept;
+
+  // The sensor's pose in a world frame with y up and the floor at y = 0.
+  void set_pose(const Eigen::Isometry3d& world_from_sensor);
+  const Eigen::Isometry3d& pose() const;
+
+  // The people in the image: skeletons in the sensor frame, stamped and
+  // numbered like the image, person ids stable while a person is tracked.
+  // Throws std::invalid_argument for a malformed image.
+  std::vector<skeleton::Skeleton> track(const depth::DepthImage& image);
+
+  const TrackerStats& stats() const;
+  const TrackerOptions& options() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace skelgraph::depth_tracker

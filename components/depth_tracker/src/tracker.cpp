@@ -1,0 +1,435 @@
+#include "skelgraph/depth_tracker/tracker.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <stdexcept>
+
+#include <Eigen/Cholesky>
+
+#include "skelgraph/depth/cloud.hpp"
+
+namespace skelgraph::depth_tracker {
+
+using skeleton::JointId;
+using Eigen::Vector3d;
+constexpr std::size_t kJ = skeleton::kJointCount;
+constexpr int kN = static_cast<int>(kJ) * 3;
+using Mat = Eigen::Matrix<double, kN, kN>;
+using Vec = Eigen::Matrix<double, kN, 1>;
+using Pose = std::array<Vector3d, kJ>;
+
+namespace {
+
+std::size_t idx(JointId j) { return static_cast<std::size_t>(j); }
+
+// A capsule end: a joint, or the middle of two (the pelvis).
+struct End {
+  std::size_t a, b;  // joints; a == b for a joint itself
+  Vector3d at(const Pose& p) const { return a == b ? p[a] : 0.5 * (p[a] + p[b]); }
+};
+struct Segment {
+  End from, to;
+  double radius;  // fraction of body height
+};
+
+End J(JointId j) { return {idx(j), idx(j)}; }
+End Mid(JointId a, JointId b) { return {idx(a), idx(b)}; }
+
+// The body's volume (radii as fractions of height: a 1.75 m person's head is ~0.10 m in radius).
+const std::vector<Segment>& segments() {
+  using J_ = JointId;
+  static const std::vector<Segment> s = {
+      {J(J_::Head), J(J_::Head), 0.056},
+      {J(J_::Neck), J(J_::Head), 0.030},
+      {J(J_::LeftShoulder), J(J_::RightShoulder), 0.034},
+      {J(J_::LeftShoulder), J(J_::LeftHip), 0.048},
+      {J(J_::RightShoulder), J(J_::RightHip), 0.048},
+      {J(J_::Neck), J(J_::Torso), 0.057},
+      {J(J_::Torso), Mid(J_::LeftHip, J_::RightHip), 0.062},
+      {J(J_::LeftHip), J(J_::RightHip), 0.051},
+      {J(J_::LeftShoulder), J(J_::LeftElbow), 0.026},
+      {J(J_::RightShoulder), J(J_::RightElbow), 0.026},
+      {J(J_::LeftElbow), J(J_::LeftHand), 0.022},
+      {J(J_::RightElbow), J(J_::RightHand), 0.022},
+      {J(J_::LeftHand), J(J_::LeftHand), 0.028},
+      {J(J_::RightHand), J(J_::RightHand), 0.028},
+      {J(J_::LeftHip), J(J_::LeftKnee), 0.043},
+      {J(J_::RightHip), J(J_::RightKnee), 0.043},
+      {J(J_::LeftKnee), J(J_::LeftFoot), 0.029},
+      {J(J_::RightKnee), J(J_::RightFoot), 0.029},
+      {J(J_::LeftFoot), J(J_::LeftFoot), 0.029},
+      {J(J_::RightFoot), J(J_::RightFoot), 0.029},
+  };
+  return s;
+}
+
+// Pairs whose distance is kept: the bones, and enough links to keep the trunk rigid.
+const std::vector<std::pair<JointId, JointId>>& links() {
+  using J_ = JointId;
+  static const std::vector<std::pair<JointId, JointId>> l = {
+      {J_::Neck, J_::Head},          {J_::Torso, J_::Head},          {J_::Neck, J_::Torso},          {J_::Neck, J_::LeftShoulder},
+      {J_::Neck, J_::RightShoulder}, {J_::LeftShoulder, J_::RightShoulder}, {J_::Torso, J_::LeftShoulder}, {J_::Torso, J_::RightShoulder},
+      {J_::Torso, J_::LeftHip},      {J_::Torso, J_::RightHip},      {J_::LeftHip, J_::RightHip},    {J_::LeftShoulder, J_::LeftHip},
+      {J_::RightShoulder, J_::RightHip}, {J_::LeftShoulder, J_::RightHip}, {J_::RightShoulder, J_::LeftHip}, {J_::Neck, J_::LeftHip},
+      {J_::Neck, J_::RightHip},      {J_::LeftShoulder, J_::LeftElbow}, {J_::LeftElbow, J_::LeftHand}, {J_::RightShoulder, J_::RightElbow},
+      {J_::RightElbow, J_::RightHand}, {J_::LeftHip, J_::LeftKnee},  {J_::LeftKnee, J_::LeftFoot},   {J_::RightHip, J_::RightKnee},
+      {J_::RightKnee, J_::RightFoot},
+  };
+  return l;
+}
+
+// A standing person `h` tall, pelvis over `centre` (x, z), facing `fwd`
+// (horizontal), arms hanging slightly away from the body. Proportions of
+// height after Drillis & Contini (Winter, "Biomechanics and Motor Control
+// of Human Movement").
+Pose standing(double h, const Vector3d& centre, const Vector3d& fwd) {
+  const Vector3d up = Vector3d::UnitY();
+  const Vector3d left = up.cross(fwd).normalized();
+  Pose p;
+  const Vector3d pelvis(centre.x(), 0.530 * h, centre.z());
+  const Vector3d neck = pelvis + 0.288 * h * up;
+  p[idx(JointId::Neck)] = neck;
+  p[idx(JointId::Torso)] = 0.5 * (pelvis + neck);
+  p[idx(JointId::Head)] = neck + 0.118 * h * up;
+  for (int side = 0; side < 2; ++side) {
+    const double sign = side == 0 ? 1.0 : -1.0;
+    const Vector3d out = sign * left;
+    const Vector3d shoulder = neck + 0.1295 * h * out;
+    const Vector3d arm_dir = (-up * std::cos(0.25) + out * std::sin(0.25)).normalized();
+    const Vector3d elbow = shoulder + 0.186 * h * arm_dir;
+    const Vector3d hand = elbow + 0.195 * h * arm_dir;
+    const Vector3d hip = pelvis + 0.055 * h * out;
+    const Vector3d knee = hip - 0.245 * h * up;
+    const Vector3d foot = knee - 0.246 * h * up;
+    const bool l = side == 0;
+    p[idx(l ? JointId::LeftShoulder : JointId::RightShoulder)] = shoulder;
+    p[idx(l ? JointId::LeftElbow : JointId::RightElbow)] = elbow;
+    p[idx(l ? JointId::LeftHand : JointId::RightHand)] = hand;
+    p[idx(l ? JointId::LeftHip : JointId::RightHip)] = hip;
+    p[idx(l ? JointId::LeftKnee : JointId::RightKnee)] = knee;
+    p[idx(l ? JointId::LeftFoot : JointId::RightFoot)] = foot;
+  }
+  return p;
+}
+
+Vector3d pelvis_of(const Pose& p) { return 0.5 * (p[idx(JointId::LeftHip)] + p[idx(JointId::RightHip)]); }
+
+struct Person {
+  std::uint32_t id = 0;
+  double height = 1.75;
+  Pose pose{};
+  std::vector<double> lengths;  // per link
+  std::int64_t last_seen_ns = 0;
+  std::array<double, kJ> support{};
+};
+
+// Closest point on segment a-b to p, as the fraction along it.
+double closest_fraction(const Vector3d& a, const Vector3d& b, const Vector3d& p) {
+  const Vector3d ab = b - a;
+  const double len2 = ab.squaredNorm();
+  if (len2 < 1e-12) return 0.0;
+  return std::clamp((p - a).dot(ab) / len2, 0.0, 1.0);
+}
+
+}  // namespace
+
+struct DepthTracker::Impl {
+  TrackerOptions opt;
+  Eigen::Isometry3d world_from_sensor = Eigen::Isometry3d::Identity();
+  std::vector<Person> people;
+  std::uint32_t next_id = 1;
+  TrackerStats stats;
+
+  struct Fit {
+    double mean_abs = 0.0;  // mean |distance to the surface| of the inlying points
+    double inliers = 0.0;   // their share of the points
+    double score() const { return mean_abs + 0.1 * (1.0 - inliers); }
+  };
+  // Fits `person` to the points.
+  Fit fit(Person& person, const depth::Points& points, int iterations) const;
+};
+
+DepthTracker::DepthTracker(TrackerOptions options) : impl_(std::make_unique<Impl>()) {
+  if (!(options.voxel_m > 0) || options.iterations < 1 || options.init_iterations < 1 || !(options.outlier_m > 0) ||
+      !(options.bone_weight >= 0) || !(options.smooth_weight >= 0) || !(options.max_height_m > options.min_height_m)) {
+    throw std::invalid_argument("depth tracker: bad options");
+  }
+  impl_->opt = options;
+  Eigen::Isometry3d level = Eigen::Isometry3d::Identity();
+  level.translation() = Vector3d(0.0, 1.2, 0.0);
+  impl_->world_from_sensor = level;
+}
+DepthTracker::~DepthTracker() = default;
+DepthTracker::DepthTracker(DepthTracker&&) noexcept = default;
+DepthTracker& DepthTracker::operator=(DepthTracker&&) noexcept = default;
+
+void DepthTracker::set_pose(const Eigen::Isometry3d& world_from_sensor) { impl_->world_from_sensor = world_from_sensor; }
+const Eigen::Isometry3d& DepthTracker::pose() const { return impl_->world_from_sensor; }
+const TrackerStats& DepthTracker::stats() const { return impl_->stats; }
+const TrackerOptions& DepthTracker::options() const { return impl_->opt; }
+
+DepthTracker::Impl::Fit DepthTracker::Impl::fit(Person& person, const depth::Points& points, int iterations) const {
+  const auto& segs = segments();
+  const auto& lks = links();
+  const Pose previous = person.pose;
+  Fit result;
+  std::vector<double> radius(segs.size());
+  for (std::size_t s = 0; s < segs.size(); ++s) radius[s] = segs[s].radius * person.height;
+  std::vector<int> inliers(segs.size());
+  for (int it = 0; it < iterations; ++it) {
+    Mat A = Mat::Zero();
+    Vec b = Vec::Zero();
+    std::fill(inliers.begin(), inliers.end(), 0);
+    double abs_sum = 0.0;
+    int used = 0;
+    const Pose& x = person.pose;
+    std::vector<Vector3d> ends_a(segs.size()), ends_b(segs.size());
+    for (std::size_t s = 0; s < segs.size(); ++s) {
+      ends_a[s] = segs[s].from.at(x);
+      ends_b[s] = segs[s].to.at(x);
+    }
+    for (const auto& pf : points) {
+      const Vector3d p = pf.cast<double>();
+      // The capsule whose surface is nearest (signed: inside counts as nearer).
+      double best = 1e9, best_s_frac = 0.0;
+      std::size_t best_seg = 0;
+      for (std::size_t s = 0; s < segs.size(); ++s) {
+        const double f = closest_fraction(ends_a[s], ends_b[s], p);
+        const double d = (p - (ends_a[s] + f * (ends_b[s] - ends_a[s]))).norm() - radius[s];
+        if (d < best) {
+          best = d;
+          best_seg = s;
+          best_s_frac = f;
+        }
+      }
+      if (std::abs(best) > opt.outlier_m) continue;
+      const Vector3d q = ends_a[best_seg] + best_s_frac * (ends_b[best_seg] - ends_a[best_seg]);
+      const Vector3d diff = p - q;
+      const double dist = diff.norm();
+      if (dist < 1e-9) continue;
+      const Vector3d n = diff / dist;
+      const double e = dist - radius[best_seg];
+      const double w = std::abs(e) < 0.03 ? 1.0 : 0.03 / std::abs(e);  // Huber
+      ++inliers[best_seg];
+      abs_sum += std::abs(e);
+      ++used;
+      // q = (1-f) * from + f * to; from/to are joints or the mean of two.
+      std::array<std::pair<std::size_t, double>, 4> coef = {{{segs[best_seg].from.a, 0.5 * (1 - best_s_frac)},
+                                                             {segs[best_seg].from.b, 0.5 * (1 - best_s_frac)},
+                                                             {segs[best_seg].to.a, 0.5 * best_s_frac},
+                                                             {segs[best_seg].to.b, 0.5 * best_s_frac}}};
+      // d e / d joint_k = -c_k n^T
+      for (const auto& [jk, ck] : coef) {
+        if (ck == 0.0) continue;
+        for (const auto& [jl, cl] : coef) {
+          if (cl == 0.0) continue;
+          A.block<3, 3>(3 * static_cast<int>(jk), 3 * static_cast<int>(jl)) += w * ck * cl * (n * n.transpose());
+        }
+        b.segment<3>(3 * static_cast<int>(jk)) += w * ck * n * e;  // -J^T e with J = -c n^T
+      }
+    }
+    result.mean_abs = used > 0 ? abs_sum / used : 0.0;
+    result.inliers = points.empty() ? 0.0 : static_cast<double>(used) / static_cast<double>(points.size());
+    // Bone lengths and the trunk's shape.
+    for (std::size_t l = 0; l < lks.size(); ++l) {
+      const auto i = idx(lks[l].first), j = idx(lks[l].second);
+      const Vector3d d = x[i] - x[j];
+      const double len = d.norm();
+      if (len < 1e-9) continue;
+      const Vector3d u = d / len;
+      const double e = len - person.lengths[l];
+      const Eigen::Matrix3d uu = opt.bone_weight * u * u.transpose();
+      A.block<3, 3>(3 * static_cast<int>(i), 3 * static_cast<int>(i)) += uu;
+      A.block<3, 3>(3 * static_cast<int>(j), 3 * static_cast<int>(j)) += uu;
+      A.block<3, 3>(3 * static_cast<int>(i), 3 * static_cast<int>(j)) -= uu;
+      A.block<3, 3>(3 * static_cast<int>(j), 3 * static_cast<int>(i)) -= uu;
+      b.segment<3>(3 * static_cast<int>(i)) -= opt.bone_weight * u * e;
+      b.segment<3>(3 * static_cast<int>(j)) += opt.bone_weight * u * e;
+    }
+    // Towards the previous frame's pose, and a little damping.
+    for (std::size_t k = 0; k < kJ; ++k) {
+      A.block<3, 3>(3 * static_cast<int>(k), 3 * static_cast<int>(k)) +=
+          (opt.smooth_weight + 0.5) * Eigen::Matrix3d::Identity();
+      b.segment<3>(3 * static_cast<int>(k)) -= opt.smooth_weight * (x[k] - previous[k]);
+    }
+    const Vec step = A.ldlt().solve(b);
+    if (!step.allFinite()) break;
+    for (std::size_t k = 0; k < kJ; ++k) {
+      Vector3d s = step.segment<3>(3 * static_cast<int>(k));
+      if (s.norm() > 0.1) s *= 0.1 / s.norm();  // a step never jumps more than 10 cm
+      person.pose[k] += s;
+    }
+  }
+  // Support per joint: inlying points on the segments that move it.
+  person.support.fill(0.0);
+  for (std::size_t s = 0; s < segs.size(); ++s) {
+    for (const auto j : {segs[s].from.a, segs[s].from.b, segs[s].to.a, segs[s].to.b}) {
+      person.support[j] += inliers[s];
+    }
+  }
+  return result;
+}
+
+std::vector<skeleton::Skeleton> DepthTracker::track(const depth::DepthImage& image) {
+  depth::check(image);
+  auto& d = *impl_;
+  const auto& opt = d.opt;
+  ++d.stats.frames;
+  const int w = image.width(), h = image.height();
+  const Eigen::Matrix3d R = d.world_from_sensor.linear();
+  const Vector3d t = d.world_from_sensor.translation();
+
+  // Everything with a reading above the floor.
+  std::vector<std::uint8_t> mask(image.mm.size(), 0);
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const auto i = static_cast<std::size_t>(v) * w + u;
+      if (image.mm[i] == 0) continue;
+      const double y = R.row(1).dot(depth::unproject(image.intrinsics, u, v, image.mm[i] * 1e-3)) + t.y();
+      mask[i] = y > opt.floor_margin_m;
+    }
+  }
+  const auto seg = depth::segment(image, mask, opt.max_step_m, static_cast<std::size_t>(w) * h / 400);
+
+  // Regions as thinned world points; parts of one body that depth steps split
+  // (an arm in front of the trunk seen from the side) are joined again by
+  // where they stand; then only person-shaped groups are kept.
+  struct Candidate {
+    depth::Points points;
+    Vector3d centre = Vector3d::Zero();
+    double top = 0.0;
+  };
+  std::vector<Candidate> parts;
+  for (const auto& r : seg.regions) {
+    std::vector<std::uint8_t> rm(image.mm.size(), 0);
+    for (std::size_t i = 0; i < rm.size(); ++i) rm[i] = seg.labels[i] == r.label;
+    auto pts = depth::voxel_downsample(depth::transformed(depth::to_points(image, rm), d.world_from_sensor), opt.voxel_m);
+    if (pts.size() < 5) continue;
+    Vector3d sum = Vector3d::Zero();
+    for (const auto& p : pts) sum += p.cast<double>();
+    const Vector3d centre = sum / static_cast<double>(pts.size());
+    parts.push_back({std::move(pts), centre, 0.0});
+  }
+  // Largest first (segment() sorts regions by size): each part joins the first group standing within 0.45 m.
+  std::vector<Candidate> groups;
+  for (auto& part : parts) {
+    Candidate* home = nullptr;
+    for (auto& g : groups) {
+      if (std::hypot(g.centre.x() - part.centre.x(), g.centre.z() - part.centre.z()) < 0.45) {
+        home = &g;
+        break;
+      }
+    }
+    if (home == nullptr) {
+      groups.push_back(std::move(part));
+      continue;
+    }
+    const double n0 = static_cast<double>(home->points.size()), n1 = static_cast<double>(part.points.size());
+    home->centre = (home->centre * n0 + part.centre * n1) / (n0 + n1);
+    home->points.insert(home->points.end(), part.points.begin(), part.points.end());
+  }
+  std::vector<Candidate> found;
+  for (auto& g : groups) {
+    if (g.points.size() < opt.min_points) continue;
+    Eigen::AlignedBox3d box;
+    std::vector<double> ys;
+    for (const auto& p : g.points) {
+      box.extend(p.cast<double>());
+      ys.push_back(p.y());
+    }
+    const auto k = static_cast<long>(ys.size() * 98 / 100);
+    std::nth_element(ys.begin(), ys.begin() + k, ys.end());
+    g.top = ys[static_cast<std::size_t>(k)];
+    const double width = std::hypot(box.sizes().x(), box.sizes().z());
+    if (g.top < opt.min_height_m || g.top > opt.max_height_m || width > opt.max_width_m) continue;
+    if (box.sizes().y() < opt.min_extent_m) continue;  // an arm, a box: not a whole person
+    found.push_back(std::move(g));
+  }
+  d.stats.regions += found.size();
+
+  // Continue people whose pelvis is near a region (nearest first), start new ones for the rest.
+  std::vector<bool> used(found.size(), false);
+  std::vector<skeleton::Skeleton> out;
+  const Vector3d sensor_pos = t;
+  for (auto& person : d.people) {
+    const Vector3d pel = pelvis_of(person.pose);
+    double best = opt.match_radius_m;
+    int which = -1;
+    for (std::size_t c = 0; c < found.size(); ++c) {
+      if (used[c]) continue;
+      const double dist = std::hypot(found[c].centre.x() - pel.x(), found[c].centre.z() - pel.z());
+      if (dist < best) {
+        best = dist;
+        which = static_cast<int>(c);
+      }
+    }
+    if (which < 0) continue;
+    used[static_cast<std::size_t>(which)] = true;
+    d.stats.mean_residual_m = d.fit(person, found[static_cast<std::size_t>(which)].points, opt.iterations).mean_abs;
+    person.last_seen_ns = image.stamp_ns;
+  }
+  for (std::size_t c = 0; c < found.size(); ++c) {
+    if (used[c]) continue;
+    Person p;
+    p.id = d.next_id++;
+    p.height = std::clamp(found[c].top, 1.0, 2.3);
+    Vector3d to_sensor = sensor_pos - found[c].centre;
+    to_sensor.y() = 0.0;
+    if (to_sensor.norm() < 1e-6) to_sensor = Vector3d::UnitZ();
+    to_sensor.normalize();
+    // The points are the front of the body: its middle is about a hand's breadth behind them.
+    const Vector3d centre = found[c].centre - 0.1 * to_sensor;
+    // Which way they face is not known: fit a standing template turned every
+    // 45 degrees and keep the best (facing the sensor wins ties).
+    Impl::Fit best_fit;
+    Pose best_pose{};
+    for (int k = 0; k < 8; ++k) {
+      const double a = k * M_PI / 4.0;
+      const Vector3d fwd = Eigen::AngleAxisd(a, Vector3d::UnitY()) * to_sensor;
+      Person trial = p;
+      trial.pose = standing(p.height, centre, fwd);
+      trial.lengths.clear();
+      for (const auto& [ja, jb] : links()) trial.lengths.push_back((trial.pose[idx(ja)] - trial.pose[idx(jb)]).norm());
+      const auto f = d.fit(trial, found[c].points, opt.init_iterations);
+      if (k == 0 || f.score() < best_fit.score() - 1e-3) {
+        best_fit = f;
+        p.pose = trial.pose;
+        p.lengths = trial.lengths;
+        p.support = trial.support;
+      }
+    }
+    (void)best_pose;
+    d.stats.mean_residual_m = best_fit.mean_abs;
+    p.last_seen_ns = image.stamp_ns;
+    ++d.stats.initialisations;
+    d.people.push_back(std::move(p));
+  }
+  // Forget people not seen for a while.
+  const auto lost_ns = static_cast<std::int64_t>(opt.lost_after_s * 1e9);
+  d.people.erase(std::remove_if(d.people.begin(), d.people.end(),
+                                [&](const Person& p) { return image.stamp_ns - p.last_seen_ns > lost_ns; }),
+                 d.people.end());
+
+  const Eigen::Isometry3d sensor_from_world = d.world_from_sensor.inverse();
+  for (const auto& person : d.people) {
+    if (person.last_seen_ns != image.stamp_ns) continue;
+    skeleton::Skeleton s;
+    s.sensor_id = image.sensor_id;
+    s.frame_id = image.sensor_id;
+    s.person_id = person.id;
+    s.stamp_ns = image.stamp_ns;
+    s.frame_number = image.frame_number;
+    for (std::size_t k = 0; k < kJ; ++k) {
+      s.joints[k].position = sensor_from_world * person.pose[k];
+      s.joints[k].confidence = person.support[k] >= opt.tracked_support ? skeleton::kTracked : skeleton::kInferred;
+    }
+    out.push_back(std::move(s));
+  }
+  d.stats.people_reported += out.size();
+  return out;
+}
+
+}  // namespace skelgraph::depth_tracker
