@@ -95,7 +95,9 @@ TEST(Spotting, FindsPointingInHeldOutSimulatedSessions) {
       EXPECT_GE(e.end_ns, e.start_ns);
       EXPECT_GE(e.confidence, 0.0);
       EXPECT_LE(e.confidence, 1.0);
-      if (e.has_target) EXPECT_NEAR(e.target.y(), 0.0, 1e-9);
+      if (e.has_target) {
+        EXPECT_NEAR(e.target.y(), 0.0, 1e-9);
+      }
     }
     reports.push_back(score_spotting(events, session.truth, "point"));
   }

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 
 #include "skelgraph/depth/cloud.hpp"
 
@@ -346,6 +347,16 @@ std::vector<skeleton::Skeleton> DepthTracker::track(const depth::DepthImage& ima
     const double width = std::hypot(box.sizes().x(), box.sizes().z());
     if (g.top < opt.min_height_m || g.top > opt.max_height_m || width > opt.max_width_m) continue;
     if (box.sizes().y() < opt.min_extent_m) continue;  // an arm, a box: not a whole person
+    if ((g.centre - t).norm() > opt.max_distance_m) continue;
+    // Flat: a piece of wall between shadows, not a body.
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (const auto& p : g.points) {
+      const Vector3d q = p.cast<double>() - g.centre;
+      cov += q * q.transpose();
+    }
+    cov /= static_cast<double>(g.points.size());
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+    if (std::sqrt(std::max(eig.eigenvalues()(0), 0.0)) < opt.min_thickness_m) continue;
     found.push_back(std::move(g));
   }
   d.stats.regions += found.size();
@@ -402,6 +413,29 @@ std::vector<skeleton::Skeleton> DepthTracker::track(const depth::DepthImage& ima
       }
     }
     (void)best_pose;
+    // Arms need not hang at the start: try each arm down, forward, out, up and
+    // in between, and keep what explains the points best.
+    const Vector3d up = Vector3d::UnitY();
+    const Vector3d left_dir = (p.pose[idx(JointId::LeftShoulder)] - p.pose[idx(JointId::RightShoulder)]).normalized();
+    const Vector3d fwd = left_dir.cross(up).normalized();
+    for (const auto& [sh, el, ha, out_sign] : {std::tuple{JointId::LeftShoulder, JointId::LeftElbow, JointId::LeftHand, 1.0},
+                                               std::tuple{JointId::RightShoulder, JointId::RightElbow, JointId::RightHand, -1.0}}) {
+      const Vector3d side = out_sign * left_dir;
+      for (const Vector3d& dir : {fwd, side, up, Vector3d((fwd - up).normalized()), Vector3d((fwd + up).normalized()),
+                                  Vector3d((side - up).normalized()), Vector3d((side + fwd).normalized())}) {
+        Person trial = p;
+        const double upper = (p.pose[idx(el)] - p.pose[idx(sh)]).norm();
+        const double fore = (p.pose[idx(ha)] - p.pose[idx(el)]).norm();
+        trial.pose[idx(el)] = trial.pose[idx(sh)] + upper * dir;
+        trial.pose[idx(ha)] = trial.pose[idx(el)] + fore * dir;
+        const auto f = d.fit(trial, found[c].points, opt.init_iterations / 2);
+        if (f.score() < best_fit.score() - 1e-3) {
+          best_fit = f;
+          p.pose = trial.pose;
+          p.support = trial.support;
+        }
+      }
+    }
     d.stats.mean_residual_m = best_fit.mean_abs;
     p.last_seen_ns = image.stamp_ns;
     ++d.stats.initialisations;
@@ -422,9 +456,22 @@ std::vector<skeleton::Skeleton> DepthTracker::track(const depth::DepthImage& ima
     s.person_id = person.id;
     s.stamp_ns = image.stamp_ns;
     s.frame_number = image.frame_number;
+    // Seen from the side (the shoulder line within 45 degrees of the line of
+    // sight), a body's front and back look alike: which arm is left is a guess.
+    Vector3d across = person.pose[idx(JointId::LeftShoulder)] - person.pose[idx(JointId::RightShoulder)];
+    Vector3d sight = person.pose[idx(JointId::Neck)] - t;
+    across.y() = 0.0;
+    sight.y() = 0.0;
+    const bool side_on = across.norm() > 1e-6 && sight.norm() > 1e-6 &&
+                         std::abs(across.normalized().dot(sight.normalized())) > std::cos(M_PI / 4.0);
     for (std::size_t k = 0; k < kJ; ++k) {
       s.joints[k].position = sensor_from_world * person.pose[k];
-      s.joints[k].confidence = person.support[k] >= opt.tracked_support ? skeleton::kTracked : skeleton::kInferred;
+      const bool sided = skeleton::mirror(skeleton::joint_at(k)) != skeleton::joint_at(k);
+      if (side_on && sided) {
+        s.joints[k].confidence = skeleton::kLost;  // reported, but no side can be vouched for
+      } else {
+        s.joints[k].confidence = person.support[k] >= opt.tracked_support ? skeleton::kTracked : skeleton::kInferred;
+      }
     }
     out.push_back(std::move(s));
   }

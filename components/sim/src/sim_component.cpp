@@ -75,6 +75,7 @@ runtime::ComponentInfo SimComponent::describe() {
       .add_bool("depth", false, "render each sensor's depth image (people, props, floor, walls) and publish it on skelgraph/depth")
       .add_string("depth_size", "320x240", "depth image size", {"160x120", "320x240", "640x480"})
       .add_bool("depth_noise", true, "Kinect-like depth errors: disparity noise and quantisation, drop-outs, missing edges")
+      .add_double("depth_girth", 1.1, "build of the people in the depth images (1: standard capsules; 0.85 slim, 1.25 stout)", 0.5, 2.0)
       .add_bool("publish_poses", true, "publish the sensors' true poses (off: a calibration file or component provides them)")
       .add_bool("wall_clock_aligned", false,
                 "scenario time = wall clock modulo the scenario's duration, so sims started at different times (or "
@@ -104,6 +105,7 @@ SimComponent::SimComponent(runtime::Context& ctx, const runtime::Params& params)
     const auto k = parse_depth_size(params.get<std::string>("depth_size"));
     DepthNoise noise;
     noise.enabled = params.get<bool>("depth_noise");
+    girth_ = params.get<double>("depth_girth");
     const Rng base(config_.scenario.seed);
     for (std::size_t i = 0; i < config_.sensors.size(); ++i) {
       renderers_.emplace_back(config_.sensors[i], k, noise);
@@ -161,12 +163,14 @@ void SimComponent::tick() {
     } else if (!publishes(e.sensor)) {
       continue;
     } else if (e.kind == SimEvent::Kind::Frame) {
-      msg::SensorFrame f;
-      f.sensor_id(e.skeleton.sensor_id);
-      f.stamp_ns(e.skeleton.stamp_ns);
-      f.frame_number(e.skeleton.frame_number);
-      f.people(e.people);
-      frame_pub_.publish(f);
+      if (publish_raw_) {  // the heartbeat of the raw skeleton stream (a depth tracker sends its own)
+        msg::SensorFrame f;
+        f.sensor_id(e.skeleton.sensor_id);
+        f.stamp_ns(e.skeleton.stamp_ns);
+        f.frame_number(e.skeleton.frame_number);
+        f.people(e.people);
+        frame_pub_.publish(f);
+      }
       if (depth_pub_) publish_depth(e);
     } else if (publish_raw_) {
       raw_pub_.publish(skeleton::to_msg(e.skeleton));
@@ -190,7 +194,7 @@ void SimComponent::tick() {
 void SimComponent::publish_depth(const SimEvent& frame) {
   const double t = frame.t;  // the frame's capture time on the world clock
   auto image = renderers_[frame.sensor].render(sim_->truth_at(t), sim_->scenario().at(t).obstacles,
-                                               depth_rngs_[frame.sensor], config_.scenario.height);
+                                               depth_rngs_[frame.sensor], config_.scenario.height, girth_);
   image.stamp_ns = frame.skeleton.stamp_ns;
   image.frame_number = frame.skeleton.frame_number;
   depth_pub_->publish(depth::to_msg(std::move(image)));

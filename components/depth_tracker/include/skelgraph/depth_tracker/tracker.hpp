@@ -13,7 +13,10 @@
 // template facing the sensor, scaled to the height of their region; a person
 // not seen for `lost_after_s` is dropped and starts again when found.
 // Per-joint confidence: 1 when enough points support the joint's segments,
-// 0.5 (inferred) when not.
+// 0.5 (inferred) when not; the sided joints (shoulders, arms, legs) are
+// reported at confidence 0 whenever the person is seen side-on, where front
+// and back (and so left and right) cannot be told apart: fusion then takes
+// them from a sensor that can tell.
 //
 // Frames: the image's sensor frame (skeletons are reported in it, like any
 // tracker's), and a world frame with y up and the floor at y = 0, given by the
@@ -37,6 +40,8 @@ struct TrackerOptions {
   double max_step_m = 0.08;        // neighbouring pixels further apart in depth belong to different regions
   double min_height_m = 0.9, max_height_m = 2.4;  // a person's region: top above the floor
   double min_extent_m = 0.8;       // ... and vertical extent (legs may be out of view)
+  double min_thickness_m = 0.015;  // ... and not flat: spread across its flattest direction (sd)
+  double max_distance_m = 5.0;     // ... and this close to the sensor (Kinect-class trackers reach ~4 m)
   double max_width_m = 2.2;        // ... and horizontal extent (arms spread: about the height)
   std::size_t min_points = 60;     // ... and points after thinning
   double outlier_m = 0.15;         // points farther than this from the model's surface are ignored

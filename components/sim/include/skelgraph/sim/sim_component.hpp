@@ -41,6 +41,7 @@ class SimComponent final : public runtime::Component {
   std::unique_ptr<runtime::Publisher<msg::DepthFrame>> depth_pub_;  // with `depth`
   std::vector<DepthRenderer> renderers_;                             // per sensor, with `depth`
   std::vector<Rng> depth_rngs_;
+  double girth_ = 1.1;
   runtime::TimerHandle timer_;
   std::int64_t start_mono_ns_ = 0;
   std::vector<std::string> publish_sensors_;  // empty: all

@@ -1,0 +1,144 @@
+#include "skelgraph/depth_tracker/depth_tracker_component.hpp"
+
+#include <chrono>
+#include <sstream>
+
+#include <spdlog/spdlog.h>
+
+#include "skelgraph/depth/depth_msg.hpp"
+#include "skelgraph/skeleton/skeleton_msg.hpp"
+
+namespace skelgraph::depth_tracker {
+
+runtime::ComponentInfo DepthTrackerComponent::describe() {
+  runtime::ComponentInfo info{"depth_tracker",
+                              "Open skeleton tracking from depth: skelgraph/depth (+ each sensor's pose on "
+                              "skelgraph/calibration) to skelgraph/skeleton/raw",
+                              {}};
+  const TrackerOptions d;
+  info.params.add_double("voxel_m", d.voxel_m, "the person's points are thinned to one per cube of this side", 0.005, 0.2)
+      .add_int("iterations", d.iterations, "model-fitting steps per frame", 1, 100)
+      .add_double("floor_margin_m", d.floor_margin_m, "points this close above the floor are floor", 0.0, 0.5)
+      .add_double("tracked_support", d.tracked_support, "points on a joint's segments for confidence 1", 0.0, 1000.0)
+      .add_double("lost_after_s", d.lost_after_s, "a person not seen this long is dropped", 0.05, 60.0)
+      .add_bool("assume_level", false,
+                "track sensors with no pose on skelgraph/calibration as level, sensor_height above the floor "
+                "(off: wait for their pose)")
+      .add_double("sensor_height", 1.2, "with assume_level: the sensors' height above the floor, m", 0.1, 5.0);
+  return info;
+}
+
+namespace {
+TrackerOptions options_from(const runtime::Params& p) {
+  TrackerOptions o;
+  o.voxel_m = p.get<double>("voxel_m");
+  o.iterations = static_cast<int>(p.get<std::int64_t>("iterations"));
+  o.floor_margin_m = p.get<double>("floor_margin_m");
+  o.tracked_support = p.get<double>("tracked_support");
+  o.lost_after_s = p.get<double>("lost_after_s");
+  return o;
+}
+}  // namespace
+
+DepthTrackerComponent::DepthTrackerComponent(runtime::Context& ctx, const runtime::Params& params)
+    : Component(ctx),
+      options_(options_from(params)),
+      assume_level_(params.get<bool>("assume_level")),
+      sensor_height_(params.get<double>("sensor_height")),
+      raw_pub_(ctx, runtime::topics::kSkeletonRaw),
+      frame_pub_(ctx, runtime::topics::kSensorFrame),
+      pose_sub_(ctx, runtime::topics::kCalibration,
+                [this](const msg::SensorPose& m, const runtime::SampleMeta&) {
+                  const auto p = skeleton::from_msg(m);
+                  if (p.frame_id != "world") return;  // the floor is known in the world frame only
+                  std::lock_guard<std::mutex> lock(mutex_);
+                  poses_[p.sensor_id] = p.pose;
+                  auto it = sensors_.find(p.sensor_id);
+                  if (it != sensors_.end()) {
+                    it->second.tracker.set_pose(p.pose);
+                    it->second.posed = true;
+                  }
+                }),
+      depth_sub_(ctx, runtime::topics::kDepth,
+                 [this](const msg::DepthFrame& f, const runtime::SampleMeta&) { on_depth(f); }) {
+  DepthTracker probe(options_);  // checks the options before the graph starts
+}
+
+void DepthTrackerComponent::on_depth(const msg::DepthFrame& frame) {
+  depth::DepthImage image;
+  try {
+    image = depth::from_msg(frame);
+  } catch (const std::invalid_argument& e) {
+    ctx_.set_health(runtime::HealthState::Degraded, std::string("malformed depth frame: ") + e.what());
+    return;
+  }
+  std::vector<skeleton::Skeleton> people;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    auto it = sensors_.find(image.sensor_id);
+    if (it == sensors_.end()) {
+      it = sensors_.emplace(image.sensor_id, Sensor{DepthTracker(options_)}).first;
+      auto pose = poses_.find(image.sensor_id);
+      if (pose != poses_.end()) {
+        it->second.tracker.set_pose(pose->second);
+        it->second.posed = true;
+      } else if (assume_level_) {
+        Eigen::Isometry3d level = Eigen::Isometry3d::Identity();
+        level.translation() = Eigen::Vector3d(0.0, sensor_height_, 0.0);
+        it->second.tracker.set_pose(level);
+      }
+    }
+    auto& s = it->second;
+    if (!s.posed && !assume_level_) {
+      if (s.skipped++ == 0) {
+        ctx_.set_health(runtime::HealthState::Degraded,
+                        "waiting for the pose of " + image.sensor_id + " on skelgraph/calibration");
+      }
+      return;
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    people = s.tracker.track(image);
+    s.track_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    ++s.frames;
+    s.skeletons += people.size();
+    if (s.frames == 1) ctx_.set_health(runtime::HealthState::Ok, "tracking");
+  }
+  for (const auto& p : people) raw_pub_.publish(skeleton::to_msg(p));
+  msg::SensorFrame f;
+  f.sensor_id(image.sensor_id);
+  f.stamp_ns(image.stamp_ns);
+  f.frame_number(image.frame_number);
+  f.people(static_cast<std::uint32_t>(people.size()));
+  frame_pub_.publish(f);
+}
+
+std::string DepthTrackerComponent::summary() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::ostringstream os;
+  bool first = true;
+  for (const auto& [id, s] : sensors_) {
+    os << (first ? "" : "; ") << id << ": " << s.frames << " images, " << s.skeletons << " skeletons";
+    if (s.frames > 0) os << ", " << static_cast<int>(1e3 * s.track_s / static_cast<double>(s.frames) * 10) / 10.0 << " ms each";
+    if (s.skipped > 0) os << ", " << s.skipped << " waited for a pose";
+    first = false;
+  }
+  if (first) os << "no depth images yet";
+  return os.str();
+}
+
+nlohmann::json DepthTrackerComponent::details() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  nlohmann::json sensors = nlohmann::json::object();
+  for (const auto& [id, s] : sensors_) {
+    sensors[id] = {{"images", s.frames},
+                   {"skeletons", s.skeletons},
+                   {"skipped_without_pose", s.skipped},
+                   {"people_started", s.tracker.stats().initialisations},
+                   {"track_ms_per_image", s.frames ? 1e3 * s.track_s / static_cast<double>(s.frames) : 0.0}};
+  }
+  return {{"sensors", sensors}};
+}
+
+}  // namespace skelgraph::depth_tracker
+
+SKELGRAPH_REGISTER_COMPONENT(depth_tracker, skelgraph::depth_tracker::DepthTrackerComponent)

@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# The depth path end to end (bringup/depth_sim.yaml): the simulator's depth
+# images of two sensors -> the open depth tracker -> kalman fusion -> gesture
+# spotting. Checks rates on every stage, one person (no ghosts from walls),
+# pointing events with floor targets, and a tracker that waits for poses.
+source "$(dirname "$0")/lib.sh"
+
+"$SKELGRAPH" launch bringup/depth_sim.yaml --duration 32 --json >"$WORK/launch.json" 2>"$WORK/launch.err" &
+graph=$!
+"$SKELGRAPH" topic echo skelgraph/gesture/event --json --timeout 40 >"$WORK/events.jsonl" 2>/dev/null &
+echo_pid=$!
+sleep 6
+for t in depth skeleton/raw skeleton/fused; do
+  "$SKELGRAPH" topic hz "skelgraph/$t" --json --window 3 --timeout 10 >"$WORK/hz_${t//\//_}.json" || fail "no skelgraph/$t: $(tail -5 "$WORK/launch.err")"
+done
+wait "$graph" || fail "launch: $(tail -5 "$WORK/launch.err")"
+kill "$echo_pid" 2>/dev/null || true
+json_check "$WORK/hz_depth.json" '50 < d["rate_hz"] < 70'            # two sensors at 30 Hz
+json_check "$WORK/hz_skeleton_raw.json" '50 < d["rate_hz"] < 70'     # one person in each
+json_check "$WORK/hz_skeleton_fused.json" '25 < d["rate_hz"] < 36'
+python3 - "$WORK/launch.json" "$WORK/events.jsonl" <<'PY' || fail "graph report: $(cat "$WORK/launch.json")"
+import json, sys
+rep = {c["name"]: c for c in json.load(open(sys.argv[1]))["components"]}
+for name in ("sim", "depth_tracker", "fusion", "gesture"):
+    assert rep[name]["state"] == "OK", (name, rep[name]["state"], rep[name].get("message"))
+sim = rep["sim"]["details"]
+assert sim["raw_published"] == 0 and sim["depth_published"] > 1500, sim
+trk = rep["depth_tracker"]["details"]["sensors"]
+for s in ("sensor1", "sensor2"):
+    t = trk[s]
+    assert t["images"] > 700 and t["skeletons"] >= 0.95 * t["images"], (s, t)   # the person in nearly every image
+    assert t["skeletons"] <= t["images"], (s, t)                              # and nobody else
+    assert t["people_started"] <= 2, (s, t)
+events = [json.loads(l)["data"] for l in open(sys.argv[2]) if l.strip()]
+points = [e for e in events if e["label"] == "point"]
+assert len(points) >= 2, events
+assert all(e["has_target"] and abs(e["target"]["y"]) < 1e-6 for e in points), points
+assert len({e["person_id"] for e in points}) == 1, points
+print("tracker:", {s: (trk[s]["images"], trk[s]["skeletons"], round(trk[s]["track_ms_per_image"], 1)) for s in trk},
+      "points:", [(round(e["target"]["x"], 2), round(e["target"]["z"], 2)) for e in points])
+PY
+ok "depth -> tracker -> fusion -> gesture"
+
+# Without poses (publish_poses off, no calibration) the tracker waits and says so.
+"$SKELGRAPH" run sim -p depth=true -p publish_raw=false -p publish_poses=false -p sensor_count=1 -p loop=true \
+  --duration 6 >/dev/null 2>"$WORK/sim2.err" &
+sim2=$!
+"$SKELGRAPH" run depth_tracker --duration 5 --json >"$WORK/waiting.json" 2>"$WORK/waiting.err" || fail "tracker: $(cat "$WORK/waiting.err")"
+wait "$sim2" || true
+json_check "$WORK/waiting.json" 'd["components"][0]["state"] == "DEGRADED" and "waiting for the pose of sensor1" in d["components"][0]["message"] and d["components"][0]["details"]["sensors"]["sensor1"]["skeletons"] == 0'
+ok "no pose: tracker waits and says why"

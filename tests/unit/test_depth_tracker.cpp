@@ -1,0 +1,155 @@
+// The open depth tracker on rendered depth images: it finds the person, fits
+// the body model close to the truth, stays on one id, says when it cannot tell
+// sides, ignores walls, and forgets people who leave.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "skelgraph/depth_tracker/sim_depth.hpp"
+#include "skelgraph/depth_tracker/tracker.hpp"
+#include "skelgraph/sim/body.hpp"
+#include "skelgraph/sim/depth_render.hpp"
+
+using namespace skelgraph;
+using skeleton::JointId;
+
+namespace {
+sim::SensorConfig sensor_at(const Eigen::Vector3d& position, double yaw_deg) {
+  sim::SensorConfig c;
+  c.id = "s";
+  c.position = position;
+  c.yaw = yaw_deg * M_PI / 180.0;
+  return c;
+}
+// A standing person at the origin facing heading_deg (0: +z), right arm held out forward.
+skeleton::Skeleton person(double heading_deg, double x = 0.0) {
+  sim::BodyPose pose;
+  pose.floor_position = Eigen::Vector2d(x, 0.0);
+  pose.heading = heading_deg * M_PI / 180.0;
+  pose.right_arm = sim::arm_forward();
+  return sim::forward_kinematics(sim::BodyDimensions::from_height(1.75), pose);
+}
+depth::DepthImage shot(const sim::DepthRenderer& r, const std::vector<skeleton::Skeleton>& people, sim::Rng& rng,
+                       std::int64_t t_ns) {
+  auto img = r.render(people, {}, rng, 1.75, 1.1);
+  img.stamp_ns = t_ns;
+  return img;
+}
+}  // namespace
+
+TEST(DepthTracker, FitsAPersonFacingTheSensorWithinAFewCentimetres) {
+  const auto cfg = sensor_at({0.0, 1.2, 2.5}, 180.0);  // 2.5 m in front, looking at them
+  sim::DepthRenderer r(cfg, depth::kinect_intrinsics(320, 240));
+  depth_tracker::DepthTracker tracker;
+  tracker.set_pose(cfg.world_from_sensor());
+  sim::Rng rng(5);
+  const auto truth = person(0.0);
+  std::vector<skeleton::Skeleton> out;
+  for (int k = 0; k < 10; ++k) out = tracker.track(shot(r, {truth}, rng, k * 33'000'000));
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].sensor_id, "s");
+  EXPECT_EQ(out[0].stamp_ns, 9 * 33'000'000);
+  double sum = 0;
+  for (std::size_t j = 0; j < skeleton::kJointCount; ++j) {
+    const auto id = skeleton::joint_at(j);
+    if (id == JointId::LeftFoot || id == JointId::RightFoot) continue;  // at the floor, partly cut with it
+    const Eigen::Vector3d world = cfg.world_from_sensor() * out[0].joints[j].position;
+    const double err = (world - truth[id].position).norm();
+    EXPECT_LT(err, 0.08) << skeleton::joint_name(id);
+    sum += err;
+  }
+  EXPECT_LT(sum / 13.0, 0.04);
+  // Facing the sensor, the upper body is seen and vouched for.
+  for (auto j : {JointId::Head, JointId::Neck, JointId::Torso, JointId::LeftShoulder, JointId::RightShoulder,
+                 JointId::RightElbow, JointId::RightHand}) {
+    EXPECT_EQ(out[0][j].confidence, skeleton::kTracked) << skeleton::joint_name(j);
+  }
+  // The right hand (held forward) is on the right: left and right were not swapped.
+  const Eigen::Vector3d hand = cfg.world_from_sensor() * out[0][JointId::RightHand].position;
+  EXPECT_LT((hand - truth[JointId::RightHand].position).norm(), 0.08);
+  EXPECT_EQ(tracker.stats().initialisations, 1u);
+}
+
+TEST(DepthTracker, SeenSideOnItDoesNotVouchForLeftAndRight) {
+  const auto cfg = sensor_at({2.5, 1.2, 0.0}, -90.0);  // on +x, looking along -x at the person's left side
+  sim::DepthRenderer r(cfg, depth::kinect_intrinsics(320, 240));
+  depth_tracker::DepthTracker tracker;
+  tracker.set_pose(cfg.world_from_sensor());
+  sim::Rng rng(6);
+  sim::BodyPose pose;  // arms hanging
+  const auto truth = sim::forward_kinematics(sim::BodyDimensions::from_height(1.75), pose);
+  std::vector<skeleton::Skeleton> out;
+  for (int k = 0; k < 10; ++k) out = tracker.track(shot(r, {truth}, rng, k * 33'000'000));
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_GT(out[0][JointId::Head].confidence, 0.0f);
+  for (auto j : {JointId::LeftShoulder, JointId::RightShoulder, JointId::LeftHand, JointId::RightHand}) {
+    EXPECT_EQ(out[0][j].confidence, skeleton::kLost) << skeleton::joint_name(j);
+  }
+  const Eigen::Vector3d head = cfg.world_from_sensor() * out[0][JointId::Head].position;
+  EXPECT_LT((head - truth[JointId::Head].position).norm(), 0.06);
+}
+
+TEST(DepthTracker, AnEmptyRoomHasNobodyAndPeopleWhoLeaveAreForgotten) {
+  const auto cfg = sensor_at({0.0, 1.2, 2.5}, 180.0);
+  sim::DepthRenderer r(cfg, depth::kinect_intrinsics(320, 240));
+  depth_tracker::DepthTracker tracker;
+  tracker.set_pose(cfg.world_from_sensor());
+  sim::Rng rng(7);
+  for (int k = 0; k < 5; ++k) EXPECT_TRUE(tracker.track(shot(r, {}, rng, k * 33'000'000)).empty());  // walls, floor
+  std::uint32_t first_id = 0;
+  for (int k = 5; k < 15; ++k) {
+    const auto out = tracker.track(shot(r, {person(0.0)}, rng, k * 33'000'000));
+    ASSERT_EQ(out.size(), 1u) << k;
+    if (first_id == 0) first_id = out[0].person_id;
+    EXPECT_EQ(out[0].person_id, first_id);  // one id while tracked
+  }
+  // Gone for a second (longer than lost_after_s), then back: a new person.
+  for (int k = 15; k < 45; ++k) EXPECT_TRUE(tracker.track(shot(r, {}, rng, k * 33'000'000)).empty());
+  const auto back = tracker.track(shot(r, {person(0.0)}, rng, 45 * 33'000'000));
+  ASSERT_EQ(back.size(), 1u);
+  EXPECT_NE(back[0].person_id, first_id);
+}
+
+TEST(DepthTracker, TwoPeopleAreTwoSkeletons) {
+  const auto cfg = sensor_at({0.0, 1.2, 3.0}, 180.0);
+  sim::DepthRenderer r(cfg, depth::kinect_intrinsics(320, 240));
+  depth_tracker::DepthTracker tracker;
+  tracker.set_pose(cfg.world_from_sensor());
+  sim::Rng rng(8);
+  std::vector<skeleton::Skeleton> out;
+  for (int k = 0; k < 5; ++k) out = tracker.track(shot(r, {person(0.0, -0.7), person(0.0, 0.7)}, rng, k * 33'000'000));
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_NE(out[0].person_id, out[1].person_id);
+  const double x0 = (cfg.world_from_sensor() * out[0][JointId::Torso].position).x();
+  const double x1 = (cfg.world_from_sensor() * out[1][JointId::Torso].position).x();
+  EXPECT_NEAR(std::abs(x0 - x1), 1.4, 0.1);
+}
+
+TEST(DepthTracker, BadInputIsRefused) {
+  depth_tracker::TrackerOptions bad;
+  bad.voxel_m = 0.0;
+  EXPECT_THROW(depth_tracker::DepthTracker{bad}, std::invalid_argument);
+  depth_tracker::DepthTracker tracker;
+  auto img = depth::DepthImage::blank(depth::kinect_intrinsics(32, 24));
+  img.mm.resize(10);
+  EXPECT_THROW(tracker.track(img), std::invalid_argument);
+}
+
+TEST(DepthTracker, OnTheSimulatedPointScenarioOneSensorStaysUnderTenCentimetres) {
+  sim::SimConfig cfg;
+  cfg.scenario.name = "point";
+  cfg.sensors = sim::default_sensors(1);
+  depth_tracker::SimDepthOptions o;
+  o.intrinsics = depth::kinect_intrinsics(160, 120);  // small, to keep the test quick
+  o.girth = 1.2;
+  const auto r = depth_tracker::track_simulated_depth(cfg, o);
+  ASSERT_GT(r.frames, 100u);
+  std::map<std::string, Eigen::Isometry3d> poses{{cfg.sensors[0].id, cfg.sensors[0].world_from_sensor()}};
+  eval::OfflineOptions eo;
+  eo.methods = {};
+  const auto scored = eval::evaluate(poses, r.events, eo);
+  ASSERT_EQ(scored.streams.size(), 1u);
+  const auto& s = scored.streams[0];
+  EXPECT_GT(s.with_output, s.ticks * 9 / 10);
+  EXPECT_LT(s.accuracy.mean_error_cm(), 10.0);
+}
