@@ -28,8 +28,9 @@ int main(int argc, char** argv) {
   runtime::Publisher<msg::Skeleton> skel(ctx, runtime::topics::kSkeletonRaw);
   runtime::Publisher<msg::DepthFrame> depth(ctx, runtime::topics::kDepth);
   ctx.executor().start();
-  if (!skel.wait_for_matched(1, std::chrono::seconds(20)) || (depths > 0 && !depth.wait_for_matched(1, std::chrono::seconds(20)))) {
-    std::fprintf(stderr, "no recorder matched\n");
+  if ((skeletons > 0 && !skel.wait_for_matched(1, std::chrono::seconds(20))) ||
+      (depths > 0 && !depth.wait_for_matched(1, std::chrono::seconds(20)))) {
+    std::fprintf(stderr, "no reader matched\n");
     return 1;
   }
   std::this_thread::sleep_for(std::chrono::seconds(1));  // let discovery settle on the reader's side too
