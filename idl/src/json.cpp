@@ -1,5 +1,8 @@
 #include "skelgraph/msg/json.hpp"
 
+#include <algorithm>
+#include <array>
+
 namespace skelgraph::msg {
 
 namespace {
@@ -118,6 +121,25 @@ void to_json(nlohmann::json& j, const GestureEvent& v) {
 }
 void to_json(nlohmann::json& j, const GestureState& v) {
   j = {{"person_id", v.person_id()}, {"source", v.source()}, {"stamp_ns", v.stamp_ns()}, {"state", v.state()}};
+}
+void to_json(nlohmann::json& j, const PointCloud& v) {
+  // Summarised like depth images: the count and the bounds, not every point.
+  const auto& p = v.xyz();
+  nlohmann::json lo = nullptr, hi = nullptr;
+  if (p.size() >= 3) {
+    std::array<float, 3> a{p[0], p[1], p[2]}, b = a;
+    for (std::size_t i = 0; i + 2 < p.size(); i += 3) {
+      for (std::size_t k = 0; k < 3; ++k) {
+        a[k] = std::min(a[k], p[i + k]);
+        b[k] = std::max(b[k], p[i + k]);
+      }
+    }
+    lo = a;
+    hi = b;
+  }
+  j = {{"source", v.source()}, {"frame_id", v.frame_id()}, {"stamp_ns", v.stamp_ns()},
+       {"frame_number", v.frame_number()}, {"voxel_m", v.voxel_m()}, {"points", p.size() / 3},
+       {"min", lo}, {"max", hi}};
 }
 void to_json(nlohmann::json& j, const TopicStats& v) {
   j = {{"topic", v.topic()}, {"is_output", v.is_output()}, {"count", v.count()},

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The depth path end to end (bringup/depth_sim.yaml): the simulator's depth
 # images of two sensors -> the open depth tracker -> kalman fusion -> gesture
-# spotting. Checks rates on every stage, one person (no ghosts from walls),
-# pointing events with floor targets, and a tracker that waits for poses.
+# spotting, and the merged point cloud for viewers. Checks rates on every
+# stage, one person (no ghosts from walls), pointing events with floor
+# targets, the cloud where the person is, and a tracker that waits for poses.
 source "$(dirname "$0")/lib.sh"
 
 "$SKELGRAPH" launch bringup/depth_sim.yaml --duration 32 --json >"$WORK/launch.json" 2>"$WORK/launch.err" &
@@ -10,6 +11,7 @@ graph=$!
 "$SKELGRAPH" topic echo skelgraph/gesture/event --json --timeout 40 >"$WORK/events.jsonl" 2>/dev/null &
 echo_pid=$!
 sleep 6
+"$SKELGRAPH" topic echo skelgraph/cloud --count 1 --json --timeout 10 >"$WORK/cloud.json" || fail "no cloud"
 for t in depth skeleton/raw skeleton/fused; do
   "$SKELGRAPH" topic hz "skelgraph/$t" --json --window 3 --timeout 10 >"$WORK/hz_${t//\//_}.json" || fail "no skelgraph/$t: $(tail -5 "$WORK/launch.err")"
 done
@@ -21,7 +23,7 @@ json_check "$WORK/hz_skeleton_fused.json" '25 < d["rate_hz"] < 36'
 python3 - "$WORK/launch.json" "$WORK/events.jsonl" <<'PY' || fail "graph report: $(cat "$WORK/launch.json")"
 import json, sys
 rep = {c["name"]: c for c in json.load(open(sys.argv[1]))["components"]}
-for name in ("sim", "depth_tracker", "fusion", "gesture"):
+for name in ("sim", "depth_tracker", "fusion", "gesture", "cloud"):
     assert rep[name]["state"] == "OK", (name, rep[name]["state"], rep[name].get("message"))
 sim = rep["sim"]["details"]
 assert sim["raw_published"] == 0 and sim["depth_published"] > 1500, sim
@@ -39,7 +41,9 @@ assert len({e["person_id"] for e in points}) == 1, points
 print("tracker:", {s: (trk[s]["images"], trk[s]["skeletons"], round(trk[s]["track_ms_per_image"], 1)) for s in trk},
       "points:", [(round(e["target"]["x"], 2), round(e["target"]["z"], 2)) for e in points])
 PY
-ok "depth -> tracker -> fusion -> gesture"
+# The merged cloud of both sensors is the person: about their size, where they stand (the centre).
+json_check "$WORK/cloud.json" 'd["data"]["source"] == "merged" and d["data"]["frame_id"] == "world" and d["data"]["points"] > 500 and 1.55 < d["data"]["max"][1] < 1.95 and d["data"]["min"][1] > 0.04 and all(-1.2 < d["data"][k][i] < 1.2 for k in ("min", "max") for i in (0, 2))'
+ok "depth -> tracker -> fusion -> gesture; merged cloud of $(json_get "$WORK/cloud.json" 'd["data"]["points"]') points"
 
 # Without poses (publish_poses off, no calibration) the tracker waits and says so.
 "$SKELGRAPH" run sim -p depth=true -p publish_raw=false -p publish_poses=false -p sensor_count=1 -p loop=true \

@@ -65,7 +65,7 @@ TEST(Messages, SyncCommandDecodesWithKindName) {
 TEST(Messages, TableCoversEveryTopLevelTypeOnce) {
   const std::vector<std::string> expected = {"Skeleton",   "SyncCommand",  "SyncControl", "SyncAck",
                                              "SensorPose", "DepthFrame",   "GestureEvent", "ComponentStatus",
-                                             "ClockOffset", "TickFrames", "SensorFrame", "GestureState"};
+                                             "ClockOffset", "TickFrames", "SensorFrame", "GestureState", "PointCloud"};
   ASSERT_EQ(message_table().size(), expected.size());
   for (const auto& name : expected) {
     const auto* info = find_message("skelgraph::msg::" + name);

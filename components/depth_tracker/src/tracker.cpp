@@ -274,14 +274,12 @@ DepthTracker::Impl::Fit DepthTracker::Impl::fit(Person& person, const depth::Poi
   return result;
 }
 
-std::vector<skeleton::Skeleton> DepthTracker::track(const depth::DepthImage& image) {
+std::vector<PersonPoints> find_people(const depth::DepthImage& image, const Eigen::Isometry3d& world_from_sensor,
+                                      const TrackerOptions& opt) {
   depth::check(image);
-  auto& d = *impl_;
-  const auto& opt = d.opt;
-  ++d.stats.frames;
   const int w = image.width(), h = image.height();
-  const Eigen::Matrix3d R = d.world_from_sensor.linear();
-  const Vector3d t = d.world_from_sensor.translation();
+  const Eigen::Matrix3d R = world_from_sensor.linear();
+  const Vector3d t = world_from_sensor.translation();
 
   // Everything with a reading above the floor.
   std::vector<std::uint8_t> mask(image.mm.size(), 0);
@@ -298,16 +296,12 @@ std::vector<skeleton::Skeleton> DepthTracker::track(const depth::DepthImage& ima
   // Regions as thinned world points; parts of one body that depth steps split
   // (an arm in front of the trunk seen from the side) are joined again by
   // where they stand; then only person-shaped groups are kept.
-  struct Candidate {
-    depth::Points points;
-    Vector3d centre = Vector3d::Zero();
-    double top = 0.0;
-  };
+  using Candidate = PersonPoints;
   std::vector<Candidate> parts;
   for (const auto& r : seg.regions) {
     std::vector<std::uint8_t> rm(image.mm.size(), 0);
     for (std::size_t i = 0; i < rm.size(); ++i) rm[i] = seg.labels[i] == r.label;
-    auto pts = depth::voxel_downsample(depth::transformed(depth::to_points(image, rm), d.world_from_sensor), opt.voxel_m);
+    auto pts = depth::voxel_downsample(depth::transformed(depth::to_points(image, rm), world_from_sensor), opt.voxel_m);
     if (pts.size() < 5) continue;
     Vector3d sum = Vector3d::Zero();
     for (const auto& p : pts) sum += p.cast<double>();
@@ -359,6 +353,16 @@ std::vector<skeleton::Skeleton> DepthTracker::track(const depth::DepthImage& ima
     if (std::sqrt(std::max(eig.eigenvalues()(0), 0.0)) < opt.min_thickness_m) continue;
     found.push_back(std::move(g));
   }
+  return found;
+}
+
+std::vector<skeleton::Skeleton> DepthTracker::track(const depth::DepthImage& image) {
+  depth::check(image);
+  auto& d = *impl_;
+  const auto& opt = d.opt;
+  ++d.stats.frames;
+  const Vector3d t = d.world_from_sensor.translation();
+  auto found = find_people(image, d.world_from_sensor, opt);
   d.stats.regions += found.size();
 
   // Continue people whose pelvis is near a region (nearest first), start new ones for the rest.

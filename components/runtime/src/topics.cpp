@@ -14,7 +14,8 @@ const std::vector<TopicInfo>& known_topics() {
       info(topics::kSync),         info(topics::kSyncSession),   info(topics::kSyncControl),
       info(topics::kSyncAck),      info(topics::kSyncClock),      info(topics::kSkeletonRaw),   info(topics::kSensorFrame),   info(topics::kSkeletonFused),
       info(topics::kSkeletonTruth), info(topics::kDepth),        info(topics::kCalibration),
-      info(topics::kGestureEvent), info(topics::kGestureState), info(topics::kStatus)};
+      info(topics::kGestureEvent), info(topics::kGestureState), info(topics::kCloud),
+      info(topics::kStatus)};
   return table;
 }
 

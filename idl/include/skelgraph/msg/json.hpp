@@ -32,6 +32,7 @@ void to_json(nlohmann::json& j, const CameraIntrinsics& v);
 void to_json(nlohmann::json& j, const DepthFrame& v);
 void to_json(nlohmann::json& j, const GestureEvent& v);
 void to_json(nlohmann::json& j, const GestureState& v);
+void to_json(nlohmann::json& j, const PointCloud& v);
 void to_json(nlohmann::json& j, const TopicStats& v);
 void to_json(nlohmann::json& j, const ComponentStatus& v);
 

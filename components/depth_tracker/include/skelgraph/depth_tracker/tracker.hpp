@@ -27,6 +27,7 @@
 #include <memory>
 #include <vector>
 
+#include "skelgraph/depth/cloud.hpp"
 #include "skelgraph/depth/depth_image.hpp"
 #include "skelgraph/skeleton/skeleton.hpp"
 
@@ -57,6 +58,17 @@ struct TrackerStats {
   double mean_points = 0.0;       // per reported person
   double mean_residual_m = 0.0;   // mean |distance to surface| of inlying points, last frame
 };
+
+// A person-shaped group of points (world frame, thinned), as the tracker finds them.
+struct PersonPoints {
+  depth::Points points;
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  double top = 0.0;  // height of its top above the floor, m
+};
+// The people in a depth image (step 1 above), without fitting anyone: for
+// point clouds of people and for tests. Throws std::invalid_argument for a malformed image.
+std::vector<PersonPoints> find_people(const depth::DepthImage& image, const Eigen::Isometry3d& world_from_sensor,
+                                      const TrackerOptions& options = {});
 
 class DepthTracker {
  public:

@@ -51,6 +51,8 @@ inline const TopicDef<msg::SensorPose> kCalibration{"skelgraph/calibration", {R:
 inline const TopicDef<msg::GestureEvent> kGestureEvent{"skelgraph/gesture/event", {R::Reliable, D::Volatile, 0}};
 // Keyed by person in spirit: the latest state of each person reaches late joiners.
 inline const TopicDef<msg::GestureState> kGestureState{"skelgraph/gesture/state", {R::Reliable, D::TransientLocal, 16}};
+// Thinned point clouds for viewers (the `cloud` component): the latest only.
+inline const TopicDef<msg::PointCloud> kCloud{"skelgraph/cloud", {R::BestEffort, D::Volatile, 1}};
 inline const TopicDef<msg::ComponentStatus> kStatus{"skelgraph/status", {R::BestEffort, D::Volatile, 1}};
 
 }  // namespace topics
