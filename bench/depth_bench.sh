@@ -8,7 +8,8 @@
 # - tracker: `skelgraph eval sim --source depth` on walk, arms and point with
 #   one sensor and with two (kalman fusion), 320x240: mean error per joint
 #   group against the simulator's truth, and tracking time per image on one
-#   thread (frames per second per sensor).
+#   thread (frames per second per sensor); and one tracker fitting both
+#   sensors' merged clouds (--source depth-merged).
 # Usage: bench/depth_bench.sh BUILD_DIR [SECONDS]
 set -euo pipefail
 build=${1:?usage: depth_bench.sh BUILD_DIR [SECONDS]}
@@ -25,6 +26,7 @@ unshare -n bash -c '
 ' _ "$build" "$seconds" "$work"
 "$build/bin/skelgraph" eval sim --source depth --scenarios walk,arms,point -p sensor_count=1 --methods kalman --json >"$work/one.json" 2>/dev/null
 "$build/bin/skelgraph" eval sim --source depth --scenarios walk,arms,point -p sensor_count=2 --methods kalman,avg --json >"$work/two.json" 2>/dev/null
+"$build/bin/skelgraph" eval sim --source depth-merged --scenarios walk,arms,point -p sensor_count=2 --methods kalman --json >"$work/merged.json" 2>/dev/null
 python3 - "$work" <<'PY'
 import json, sys
 w = sys.argv[1]
@@ -41,6 +43,8 @@ def rows(path):
 print(json.dumps({
     "transport": {"published": pub["depth"], "frame_bytes": pub["depth_frame_bytes"], "streams": recv,
                   "profile": "loopback (SHM 64 MiB segment, UDP 127.0.0.1 with 4 MiB buffers)"},
-    "tracker": {"size": "320x240", "one_sensor": rows(w + "/one.json"), "two_sensors": rows(w + "/two.json")},
+    "tracker": {"size": "320x240", "one_sensor": rows(w + "/one.json"), "two_sensors": rows(w + "/two.json"),
+                "two_sensors_merged_clouds": rows(w + "/merged.json"),
+                "note": "track_ms_per_image: tracking time over every image rendered; with merged clouds one fit takes both sensors' images"},
 }, indent=2))
 PY

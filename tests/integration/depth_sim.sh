@@ -45,6 +45,18 @@ PY
 json_check "$WORK/cloud.json" 'd["data"]["source"] == "merged" and d["data"]["frame_id"] == "world" and d["data"]["points"] > 500 and 1.55 < d["data"]["max"][1] < 1.95 and d["data"]["min"][1] > 0.04 and all(-1.2 < d["data"][k][i] < 1.2 for k in ("min", "max") for i in (0, 2))'
 ok "depth -> tracker -> fusion -> gesture; merged cloud of $(json_get "$WORK/cloud.json" 'd["data"]["points"]') points"
 
+# Merged views: one tracker fitting both sensors' points, published as sensor "merged" in the world frame.
+"$SKELGRAPH" run sim -p depth=true -p publish_raw=false -p scenario=point -p loop=true --duration 12 >/dev/null 2>"$WORK/sim3.err" &
+sim3=$!
+"$SKELGRAPH" run depth_tracker -p merge=true --duration 10 --json >"$WORK/merged.json" 2>"$WORK/merged.err" &
+merged=$!
+"$SKELGRAPH" topic echo skelgraph/skeleton/raw --count 1 --json --timeout 10 >"$WORK/merged_raw.json" || fail "no merged skeleton: $(cat "$WORK/merged.err")"
+wait "$merged" || fail "merged tracker: $(cat "$WORK/merged.err")"
+wait "$sim3" || true
+json_check "$WORK/merged_raw.json" 'd["data"]["sensor_id"] == "merged" and d["data"]["frame_id"] == "world"'
+json_check "$WORK/merged.json" 'd["components"][0]["state"] == "OK" and d["components"][0]["details"]["merged"]["fits"] > 200 and d["components"][0]["details"]["merged"]["skeletons"] >= 0.95 * d["components"][0]["details"]["merged"]["fits"] and d["components"][0]["details"]["merged"]["skeletons"] <= d["components"][0]["details"]["merged"]["fits"]'
+ok "merged views: $(json_get "$WORK/merged.json" 'd["components"][0]["summary"]')"
+
 # Without poses (publish_poses off, no calibration) the tracker waits and says so.
 "$SKELGRAPH" run sim -p depth=true -p publish_raw=false -p publish_poses=false -p sensor_count=1 -p loop=true \
   --duration 6 >/dev/null 2>"$WORK/sim2.err" &

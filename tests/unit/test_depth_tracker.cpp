@@ -125,6 +125,39 @@ TEST(DepthTracker, TwoPeopleAreTwoSkeletons) {
   EXPECT_NEAR(std::abs(x0 - x1), 1.4, 0.1);
 }
 
+TEST(DepthTracker, MergedViewsFitOneModelToEverySensorsPoints) {
+  const auto front = sensor_at({0.0, 1.2, 2.5}, 180.0), side = sensor_at({2.5, 1.2, 0.0}, -90.0);
+  sim::DepthRenderer rf(front, depth::kinect_intrinsics(320, 240)), rs(side, depth::kinect_intrinsics(320, 240));
+  depth_tracker::DepthTracker merged, single;
+  single.set_pose(side.world_from_sensor());
+  sim::Rng rng(9);
+  const auto truth = person(0.0);
+  std::vector<skeleton::Skeleton> out, side_only;
+  for (int k = 0; k < 10; ++k) {
+    auto a = shot(rf, {truth}, rng, k * 33'000'000), b = shot(rs, {truth}, rng, k * 33'000'000);
+    side_only = single.track(b);
+    out = merged.track_merged({a, b}, {front.world_from_sensor(), side.world_from_sensor()});
+  }
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].sensor_id, "merged");
+  EXPECT_EQ(out[0].frame_id, "world");
+  double sum = 0;
+  for (auto j : {JointId::Head, JointId::Neck, JointId::Torso, JointId::LeftShoulder, JointId::RightShoulder,
+                 JointId::LeftElbow, JointId::RightElbow, JointId::LeftHand, JointId::RightHand}) {
+    const double err = (out[0][j].position - truth[j].position).norm();
+    EXPECT_LT(err, 0.06) << skeleton::joint_name(j);
+    EXPECT_GT(out[0][j].confidence, 0.0f) << skeleton::joint_name(j);  // the front view tells the sides
+    sum += err;
+  }
+  EXPECT_LT(sum / 9.0, 0.035);
+  EXPECT_EQ(out[0][JointId::LeftShoulder].confidence, skeleton::kTracked);
+  EXPECT_EQ(out[0][JointId::RightShoulder].confidence, skeleton::kTracked);
+  // The side sensor alone cannot vouch for the arms.
+  ASSERT_EQ(side_only.size(), 1u);
+  EXPECT_EQ(side_only[0][JointId::RightHand].confidence, skeleton::kLost);
+  EXPECT_THROW(merged.track_merged({}, {}), std::invalid_argument);
+}
+
 TEST(DepthTracker, BadInputIsRefused) {
   depth_tracker::TrackerOptions bad;
   bad.voxel_m = 0.0;

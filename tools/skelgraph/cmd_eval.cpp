@@ -412,9 +412,11 @@ int eval_sim(const SimEvalOptions& o) {
     std::vector<eval::TimedSkeleton> events;
     const bool progress = !o.json && !o.quiet;
     nlohmann::json depth_info;
-    if (o.source == "depth") {
+    if (o.source == "depth" || o.source == "depth-merged") {
       depth_tracker::SimDepthOptions dopt;
       dopt.girth = o.girth;
+      dopt.merged = o.source == "depth-merged";
+      if (dopt.merged) poses["merged"] = Eigen::Isometry3d::Identity();
       try {
         dopt.intrinsics = sim::parse_depth_size(o.depth_size);
       } catch (const std::invalid_argument& e) {
@@ -449,7 +451,7 @@ int eval_sim(const SimEvalOptions& o) {
     if (!depth_info.is_null()) out.back()["depth"] = depth_info;
     const std::string title =
         scenario + " (" + std::to_string(cfg.sensors.size()) + " sensors, " +
-        (o.source == "depth" ? "depth tracker on " + o.depth_size + " depth" : cfg.profile) + ", seed " +
+        (o.source != "tracker" ? o.source + " tracker on " + o.depth_size + " images" : cfg.profile) + ", seed " +
         std::to_string(cfg.scenario.seed) + ")";
     if (!depth_info.is_null() && !o.json && !o.quiet) {
       std::printf("\n%llu depth images: rendering %.1f ms, tracking %.1f ms per image (one thread)\n",
@@ -512,8 +514,8 @@ void add_eval_command(CLI::App& app, GlobalOptions&, Action& run) {
   s->add_flag("--json", o->json, "machine-readable results");
   s->add_option("--source", o->source,
                 "raw skeletons from: tracker (the simulator's tracker model) or depth (rendered depth images through "
-                "the open depth tracker)")
-      ->check(CLI::IsMember({"tracker", "depth"}));
+                "the open depth tracker, one per sensor) or depth-merged (one tracker fitting every sensor's points at once)")
+      ->check(CLI::IsMember({"tracker", "depth", "depth-merged"}));
   s->add_option("--depth-size", o->depth_size, "depth: image size (160x120, 320x240, 640x480)");
   s->add_option("--girth", o->girth, "depth: the simulated people's build (1: the renderer's standard; 0.85 slim, 1.25 stout)")
       ->check(CLI::Range(0.5, 2.0));

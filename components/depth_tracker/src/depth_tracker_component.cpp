@@ -24,7 +24,10 @@ runtime::ComponentInfo DepthTrackerComponent::describe() {
       .add_bool("assume_level", false,
                 "track sensors with no pose on skelgraph/calibration as level, sensor_height above the floor "
                 "(off: wait for their pose)")
-      .add_double("sensor_height", 1.2, "with assume_level: the sensors' height above the floor, m", 0.1, 5.0);
+      .add_double("sensor_height", 1.2, "with assume_level: the sensors' height above the floor, m", 0.1, 5.0)
+      .add_bool("merge", false,
+                "fit one model to every calibrated sensor's points at once and publish it as one sensor (world frame)")
+      .add_string("merged_id", "merged", "with merge: the sensor_id of the merged skeletons");
   return info;
 }
 
@@ -43,6 +46,8 @@ TrackerOptions options_from(const runtime::Params& p) {
 DepthTrackerComponent::DepthTrackerComponent(runtime::Context& ctx, const runtime::Params& params)
     : Component(ctx),
       options_(options_from(params)),
+      merge_(params.get<bool>("merge")),
+      merged_id_(params.get<std::string>("merged_id")),
       assume_level_(params.get<bool>("assume_level")),
       sensor_height_(params.get<double>("sensor_height")),
       raw_pub_(ctx, runtime::topics::kSkeletonRaw),
@@ -59,9 +64,71 @@ DepthTrackerComponent::DepthTrackerComponent(runtime::Context& ctx, const runtim
                     it->second.posed = true;
                   }
                 }),
-      depth_sub_(ctx, runtime::topics::kDepth,
-                 [this](const msg::DepthFrame& f, const runtime::SampleMeta&) { on_depth(f); }) {
+      pose_pub_(ctx, runtime::topics::kCalibration),
+      depth_sub_(ctx, runtime::topics::kDepth, [this](const msg::DepthFrame& f, const runtime::SampleMeta& meta) {
+        if (!merge_) return on_depth(f);
+        try {
+          on_depth_merged(depth::from_msg(f), meta.receive_ns);
+        } catch (const std::invalid_argument& e) {
+          ctx_.set_health(runtime::HealthState::Degraded, std::string("malformed depth frame: ") + e.what());
+        }
+      }) {
   DepthTracker probe(options_);  // checks the options before the graph starts
+  if (merge_) {
+    merged_ = std::make_unique<DepthTracker>(options_);
+    skeleton::SensorPose p;  // the merged skeletons are in the world frame already
+    p.sensor_id = merged_id_;
+    p.method = "merged";
+    pose_pub_.publish(skeleton::to_msg(p));
+  }
+}
+
+void DepthTrackerComponent::on_depth_merged(depth::DepthImage image, std::int64_t receive_ns) {
+  std::vector<skeleton::Skeleton> people;
+  std::uint32_t views = 0;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (poses_.find(image.sensor_id) == poses_.end()) {
+      if (sensors_[image.sensor_id].skipped++ == 0) {
+        ctx_.set_health(runtime::HealthState::Degraded,
+                        "waiting for the pose of " + image.sensor_id + " on skelgraph/calibration");
+      }
+      return;
+    }
+    if (lead_.empty()) lead_ = image.sensor_id;
+    const bool lead = image.sensor_id == lead_;
+    const std::string id = image.sensor_id;  // (the assignment below moves the image before it indexes)
+    ++sensors_[id].frames;
+    latest_[id] = {receive_ns, std::move(image)};
+    if (!lead) return;
+    // The lead's image with every other sensor's latest of the same moment (received within 40 ms).
+    std::vector<depth::DepthImage> images;
+    std::vector<Eigen::Isometry3d> poses;
+    for (const auto& [sensor, entry] : latest_) {
+      if (std::llabs(entry.first - receive_ns) > 40'000'000) continue;
+      images.push_back(entry.second);
+      poses.push_back(poses_.at(sensor));
+    }
+    views = static_cast<std::uint32_t>(images.size());
+    const auto t0 = std::chrono::steady_clock::now();
+    people = merged_->track_merged(images, poses, merged_id_);
+    merged_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    ++merged_fits_;
+    merged_skeletons_ += people.size();
+    if (merged_fits_ == 1) ctx_.set_health(runtime::HealthState::Ok, "tracking (merged views)");
+  }
+  std::int64_t stamp = 0;
+  for (const auto& p : people) {
+    stamp = p.stamp_ns;
+    raw_pub_.publish(skeleton::to_msg(p));
+  }
+  msg::SensorFrame f;
+  f.sensor_id(merged_id_);
+  f.stamp_ns(stamp);
+  f.frame_number(merged_fits_);
+  f.people(static_cast<std::uint32_t>(people.size()));
+  frame_pub_.publish(f);
+  (void)views;
 }
 
 void DepthTrackerComponent::on_depth(const msg::DepthFrame& frame) {
@@ -123,6 +190,10 @@ std::string DepthTrackerComponent::summary() const {
     first = false;
   }
   if (first) os << "no depth images yet";
+  if (merge_) {
+    os << "; merged: " << merged_fits_ << " fits, " << merged_skeletons_ << " skeletons";
+    if (merged_fits_ > 0) os << ", " << static_cast<int>(1e4 * merged_s_ / static_cast<double>(merged_fits_)) / 10.0 << " ms each";
+  }
   return os.str();
 }
 
@@ -136,7 +207,12 @@ nlohmann::json DepthTrackerComponent::details() const {
                    {"people_started", s.tracker.stats().initialisations},
                    {"track_ms_per_image", s.frames ? 1e3 * s.track_s / static_cast<double>(s.frames) : 0.0}};
   }
-  return {{"sensors", sensors}};
+  nlohmann::json out = {{"sensors", sensors}};
+  if (merge_) {
+    out["merged"] = {{"id", merged_id_}, {"fits", merged_fits_}, {"skeletons", merged_skeletons_},
+                     {"fit_ms", merged_fits_ ? 1e3 * merged_s_ / static_cast<double>(merged_fits_) : 0.0}};
+  }
+  return out;
 }
 
 }  // namespace skelgraph::depth_tracker

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <optional>
 
 namespace skelgraph::depth_tracker {
 
@@ -20,6 +21,10 @@ SimDepthResult track_simulated_depth(sim::SimConfig config, const SimDepthOption
   }
   using Clock = std::chrono::steady_clock;
   SimDepthResult r;
+  DepthTracker merged_tracker(options.tracker);
+  std::vector<Eigen::Isometry3d> poses;
+  for (const auto& s : config.sensors) poses.push_back(s.world_from_sensor());
+  std::vector<std::optional<std::pair<double, depth::DepthImage>>> latest(config.sensors.size());  // (world time, image)
   for (auto& e : sim.advance(sim.duration() + 1.0)) {
     const auto t_ns = config.epoch_ns + static_cast<std::int64_t>(std::llround(e.t * 1e9));
     if (e.kind == sim::SimEvent::Kind::Truth) {
@@ -33,7 +38,23 @@ SimDepthResult track_simulated_depth(sim::SimConfig config, const SimDepthOption
     image.stamp_ns = e.skeleton.stamp_ns;
     image.frame_number = e.skeleton.frame_number;
     const auto t1 = Clock::now();
-    for (auto& s : trackers[e.sensor].track(image)) r.events.push_back({eval::TimedSkeleton::Kind::Raw, t_ns, std::move(s)});
+    if (!options.merged) {
+      for (auto& s : trackers[e.sensor].track(image)) r.events.push_back({eval::TimedSkeleton::Kind::Raw, t_ns, std::move(s)});
+    } else {
+      latest[e.sensor] = std::make_pair(e.t, std::move(image));
+      if (e.sensor == 0) {
+        std::vector<depth::DepthImage> views;
+        std::vector<Eigen::Isometry3d> view_poses;
+        for (std::size_t i = 0; i < latest.size(); ++i) {
+          if (!latest[i] || e.t - latest[i]->first > 0.04) continue;  // a frame of this moment only
+          views.push_back(latest[i]->second);
+          view_poses.push_back(poses[i]);
+        }
+        for (auto& s : merged_tracker.track_merged(views, view_poses)) {
+          r.events.push_back({eval::TimedSkeleton::Kind::Raw, t_ns, std::move(s)});
+        }
+      }
+    }
     const auto t2 = Clock::now();
     r.render_s += std::chrono::duration<double>(t1 - t0).count();
     r.track_s += std::chrono::duration<double>(t2 - t1).count();

@@ -151,6 +151,8 @@ struct DepthTracker::Impl {
   };
   // Fits `person` to the points.
   Fit fit(Person& person, const depth::Points& points, int iterations) const;
+  std::vector<skeleton::Skeleton> step(std::vector<PersonPoints> found, std::int64_t stamp_ns,
+                                       const std::vector<Vector3d>& viewpoints);
 };
 
 DepthTracker::DepthTracker(TrackerOptions options) : impl_(std::make_unique<Impl>()) {
@@ -356,20 +358,16 @@ std::vector<PersonPoints> find_people(const depth::DepthImage& image, const Eige
   return found;
 }
 
-std::vector<skeleton::Skeleton> DepthTracker::track(const depth::DepthImage& image) {
-  depth::check(image);
-  auto& d = *impl_;
-  const auto& opt = d.opt;
-  ++d.stats.frames;
-  const Vector3d t = d.world_from_sensor.translation();
-  auto found = find_people(image, d.world_from_sensor, opt);
-  d.stats.regions += found.size();
-
+// Continues and starts people from this frame's person-shaped groups (world
+// frame) and returns the people seen, world frame. `viewpoints`: where the
+// sensors that saw them are (the first one decides which way a new person is
+// assumed to face on a tie).
+std::vector<skeleton::Skeleton> DepthTracker::Impl::step(std::vector<PersonPoints> found, std::int64_t stamp_ns,
+                                                         const std::vector<Vector3d>& viewpoints) {
+  stats.regions += found.size();
   // Continue people whose pelvis is near a region (nearest first), start new ones for the rest.
   std::vector<bool> used(found.size(), false);
-  std::vector<skeleton::Skeleton> out;
-  const Vector3d sensor_pos = t;
-  for (auto& person : d.people) {
+  for (auto& person : people) {
     const Vector3d pel = pelvis_of(person.pose);
     double best = opt.match_radius_m;
     int which = -1;
@@ -383,15 +381,15 @@ std::vector<skeleton::Skeleton> DepthTracker::track(const depth::DepthImage& ima
     }
     if (which < 0) continue;
     used[static_cast<std::size_t>(which)] = true;
-    d.stats.mean_residual_m = d.fit(person, found[static_cast<std::size_t>(which)].points, opt.iterations).mean_abs;
-    person.last_seen_ns = image.stamp_ns;
+    stats.mean_residual_m = fit(person, found[static_cast<std::size_t>(which)].points, opt.iterations).mean_abs;
+    person.last_seen_ns = stamp_ns;
   }
   for (std::size_t c = 0; c < found.size(); ++c) {
     if (used[c]) continue;
     Person p;
-    p.id = d.next_id++;
+    p.id = next_id++;
     p.height = std::clamp(found[c].top, 1.0, 2.3);
-    Vector3d to_sensor = sensor_pos - found[c].centre;
+    Vector3d to_sensor = viewpoints.front() - found[c].centre;
     to_sensor.y() = 0.0;
     if (to_sensor.norm() < 1e-6) to_sensor = Vector3d::UnitZ();
     to_sensor.normalize();
@@ -399,7 +397,7 @@ std::vector<skeleton::Skeleton> DepthTracker::track(const depth::DepthImage& ima
     const Vector3d centre = found[c].centre - 0.1 * to_sensor;
     // Which way they face is not known: fit a standing template turned every
     // 45 degrees and keep the best (facing the sensor wins ties).
-    Impl::Fit best_fit;
+    Fit best_fit;
     Pose best_pose{};
     for (int k = 0; k < 8; ++k) {
       const double a = k * M_PI / 4.0;
@@ -408,7 +406,7 @@ std::vector<skeleton::Skeleton> DepthTracker::track(const depth::DepthImage& ima
       trial.pose = standing(p.height, centre, fwd);
       trial.lengths.clear();
       for (const auto& [ja, jb] : links()) trial.lengths.push_back((trial.pose[idx(ja)] - trial.pose[idx(jb)]).norm());
-      const auto f = d.fit(trial, found[c].points, opt.init_iterations);
+      const auto f = fit(trial, found[c].points, opt.init_iterations);
       if (k == 0 || f.score() < best_fit.score() - 1e-3) {
         best_fit = f;
         p.pose = trial.pose;
@@ -432,7 +430,7 @@ std::vector<skeleton::Skeleton> DepthTracker::track(const depth::DepthImage& ima
         const double fore = (p.pose[idx(ha)] - p.pose[idx(el)]).norm();
         trial.pose[idx(el)] = trial.pose[idx(sh)] + upper * dir;
         trial.pose[idx(ha)] = trial.pose[idx(el)] + fore * dir;
-        const auto f = d.fit(trial, found[c].points, opt.init_iterations / 2);
+        const auto f = fit(trial, found[c].points, opt.init_iterations / 2);
         if (f.score() < best_fit.score() - 1e-3) {
           best_fit = f;
           p.pose = trial.pose;
@@ -440,36 +438,38 @@ std::vector<skeleton::Skeleton> DepthTracker::track(const depth::DepthImage& ima
         }
       }
     }
-    d.stats.mean_residual_m = best_fit.mean_abs;
-    p.last_seen_ns = image.stamp_ns;
-    ++d.stats.initialisations;
-    d.people.push_back(std::move(p));
+    stats.mean_residual_m = best_fit.mean_abs;
+    p.last_seen_ns = stamp_ns;
+    ++stats.initialisations;
+    people.push_back(std::move(p));
   }
   // Forget people not seen for a while.
   const auto lost_ns = static_cast<std::int64_t>(opt.lost_after_s * 1e9);
-  d.people.erase(std::remove_if(d.people.begin(), d.people.end(),
-                                [&](const Person& p) { return image.stamp_ns - p.last_seen_ns > lost_ns; }),
-                 d.people.end());
+  people.erase(std::remove_if(people.begin(), people.end(),
+                                [&](const Person& p) { return stamp_ns - p.last_seen_ns > lost_ns; }),
+                 people.end());
 
-  const Eigen::Isometry3d sensor_from_world = d.world_from_sensor.inverse();
-  for (const auto& person : d.people) {
-    if (person.last_seen_ns != image.stamp_ns) continue;
+  std::vector<skeleton::Skeleton> out;
+  for (const auto& person : people) {
+    if (person.last_seen_ns != stamp_ns) continue;
     skeleton::Skeleton s;
-    s.sensor_id = image.sensor_id;
-    s.frame_id = image.sensor_id;
     s.person_id = person.id;
-    s.stamp_ns = image.stamp_ns;
-    s.frame_number = image.frame_number;
+    s.stamp_ns = stamp_ns;
+    s.frame_id = "world";
     // Seen from the side (the shoulder line within 45 degrees of the line of
-    // sight), a body's front and back look alike: which arm is left is a guess.
+    // sight) by every sensor, a body's front and back look alike: which arm
+    // is left is a guess.
     Vector3d across = person.pose[idx(JointId::LeftShoulder)] - person.pose[idx(JointId::RightShoulder)];
-    Vector3d sight = person.pose[idx(JointId::Neck)] - t;
     across.y() = 0.0;
-    sight.y() = 0.0;
-    const bool side_on = across.norm() > 1e-6 && sight.norm() > 1e-6 &&
-                         std::abs(across.normalized().dot(sight.normalized())) > std::cos(M_PI / 4.0);
+    bool side_on = true;
+    for (const auto& v : viewpoints) {
+      Vector3d sight = person.pose[idx(JointId::Neck)] - v;
+      sight.y() = 0.0;
+      side_on = side_on && across.norm() > 1e-6 && sight.norm() > 1e-6 &&
+                std::abs(across.normalized().dot(sight.normalized())) > std::cos(M_PI / 4.0);
+    }
     for (std::size_t k = 0; k < kJ; ++k) {
-      s.joints[k].position = sensor_from_world * person.pose[k];
+      s.joints[k].position = person.pose[k];
       const bool sided = skeleton::mirror(skeleton::joint_at(k)) != skeleton::joint_at(k);
       if (side_on && sided) {
         s.joints[k].confidence = skeleton::kLost;  // reported, but no side can be vouched for
@@ -479,7 +479,61 @@ std::vector<skeleton::Skeleton> DepthTracker::track(const depth::DepthImage& ima
     }
     out.push_back(std::move(s));
   }
-  d.stats.people_reported += out.size();
+  stats.people_reported += out.size();
+  return out;
+}
+
+std::vector<skeleton::Skeleton> DepthTracker::track(const depth::DepthImage& image) {
+  depth::check(image);
+  auto& d = *impl_;
+  ++d.stats.frames;
+  auto out = d.step(find_people(image, d.world_from_sensor, d.opt), image.stamp_ns, {d.world_from_sensor.translation()});
+  const Eigen::Isometry3d sensor_from_world = d.world_from_sensor.inverse();
+  for (auto& s : out) {
+    s.sensor_id = image.sensor_id;
+    s.frame_id = image.sensor_id;
+    s.frame_number = image.frame_number;
+    for (auto& j : s.joints) j.position = sensor_from_world * j.position;
+  }
+  return out;
+}
+
+std::vector<skeleton::Skeleton> DepthTracker::track_merged(const std::vector<depth::DepthImage>& images,
+                                                           const std::vector<Eigen::Isometry3d>& poses,
+                                                           const std::string& id) {
+  if (images.empty() || images.size() != poses.size()) {
+    throw std::invalid_argument("track_merged: one pose per image, at least one image");
+  }
+  auto& d = *impl_;
+  ++d.stats.frames;
+  // Each sensor's people, then one group per person across sensors (standing within 0.5 m).
+  std::vector<PersonPoints> merged;
+  std::vector<Vector3d> viewpoints;
+  std::int64_t stamp = 0;
+  for (std::size_t i = 0; i < images.size(); ++i) {
+    viewpoints.push_back(poses[i].translation());
+    stamp = std::max(stamp, images[i].stamp_ns);
+    for (auto& p : find_people(images[i], poses[i], d.opt)) {
+      PersonPoints* home = nullptr;
+      for (auto& m : merged) {
+        if (std::hypot(m.centre.x() - p.centre.x(), m.centre.z() - p.centre.z()) < 0.5) home = &m;
+      }
+      if (home == nullptr) {
+        merged.push_back(std::move(p));
+        continue;
+      }
+      const double n0 = static_cast<double>(home->points.size()), n1 = static_cast<double>(p.points.size());
+      home->centre = (home->centre * n0 + p.centre * n1) / (n0 + n1);
+      home->top = std::max(home->top, p.top);
+      home->points.insert(home->points.end(), p.points.begin(), p.points.end());
+    }
+  }
+  for (auto& m : merged) m.points = depth::voxel_downsample(m.points, d.opt.voxel_m);
+  auto out = d.step(std::move(merged), stamp, viewpoints);
+  for (auto& s : out) {
+    s.sensor_id = id;
+    s.frame_number = d.stats.frames;
+  }
   return out;
 }
 

@@ -4,6 +4,11 @@
 // the floor is), runs one DepthTracker per sensor and publishes its people on
 // skelgraph/skeleton/raw (sensor frame, the image's stamp) plus a
 // skelgraph/sensor/frame heartbeat per image, like any skeleton source.
+// With `merge`, one tracker fits every calibrated sensor's points at once
+// (DepthTracker::track_merged) on each image of the first sensor seen, with
+// the others' latest images of the same moment, and publishes its skeletons
+// as sensor `merged_id` in the world frame (its pose, the identity, goes on
+// skelgraph/calibration so fusion places it).
 
 #include <map>
 #include <memory>
@@ -25,6 +30,7 @@ class DepthTrackerComponent final : public runtime::Component {
 
  private:
   void on_depth(const msg::DepthFrame& frame);
+  void on_depth_merged(depth::DepthImage image, std::int64_t receive_ns);
 
   struct Sensor {
     DepthTracker tracker;
@@ -33,6 +39,13 @@ class DepthTrackerComponent final : public runtime::Component {
     double track_s = 0.0;
   };
   TrackerOptions options_;
+  bool merge_ = false;
+  std::string merged_id_;
+  std::string lead_;  // merge: the sensor whose images trigger a fit
+  std::map<std::string, std::pair<std::int64_t, depth::DepthImage>> latest_;  // merge: receive time, image
+  std::unique_ptr<DepthTracker> merged_;
+  std::uint64_t merged_fits_ = 0, merged_skeletons_ = 0;
+  double merged_s_ = 0.0;
   bool assume_level_ = false;
   double sensor_height_ = 1.2;
   mutable std::mutex mutex_;
@@ -41,6 +54,7 @@ class DepthTrackerComponent final : public runtime::Component {
   runtime::Publisher<msg::Skeleton> raw_pub_;
   runtime::Publisher<msg::SensorFrame> frame_pub_;
   runtime::Subscription<msg::SensorPose> pose_sub_;
+  runtime::Publisher<msg::SensorPose> pose_pub_;
   runtime::Subscription<msg::DepthFrame> depth_sub_;
 };
 

@@ -18,6 +18,10 @@ struct SimDepthOptions {
   sim::DepthNoise noise;
   TrackerOptions tracker;
   double girth = 1.0;  // the simulated people's build (1: the renderer's standard capsules)
+  // One tracker fitting every sensor's points at once (track_merged), run on
+  // each frame of the first sensor with the others' latest images: raw
+  // skeletons with sensor_id "merged" in the world frame (pose: identity).
+  bool merged = false;
 };
 
 struct SimDepthResult {

@@ -25,6 +25,7 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "skelgraph/depth/cloud.hpp"
@@ -85,6 +86,13 @@ class DepthTracker {
   // numbered like the image, person ids stable while a person is tracked.
   // Throws std::invalid_argument for a malformed image.
   std::vector<skeleton::Skeleton> track(const depth::DepthImage& image);
+  // Several calibrated sensors' images of about the same moment, fitted as
+  // one: each person's points from every sensor merged in the world frame.
+  // Skeletons in the world frame, sensor_id `id`. Use a tracker either for
+  // one sensor (track) or for merged views (track_merged), not both.
+  std::vector<skeleton::Skeleton> track_merged(const std::vector<depth::DepthImage>& images,
+                                               const std::vector<Eigen::Isometry3d>& world_from_sensor,
+                                               const std::string& id = "merged");
 
   const TrackerStats& stats() const;
   const TrackerOptions& options() const;
