@@ -64,6 +64,11 @@ if "$SKELGRAPH" run openni2 -p uri="$WORK/mended.oni" -p record_directory="$WORK
   fail "recording a recording accepted"
 fi
 grep -q "record_directory is for devices" "$WORK/e3" || fail "record message: $(cat "$WORK/e3")"
+# A mode the device does not offer: the error lists what it does (Dummy: 320x240 at 30 Hz).
+if "$SKELGRAPH" run openni2 -p width=640 -p height=480 --duration 1 >/dev/null 2>"$WORK/e5"; then fail "640x480 from Dummy accepted"; fi
+grep -q "has no depth mode 640x480@any (it offers: 320x240@30 mm" "$WORK/e5" || fail "mode message: $(cat "$WORK/e5")"
+"$SKELGRAPH" run openni2 -p width=320 -p fps=30 --duration 1 --json >"$WORK/mode.json" 2>"$WORK/mode.err" || fail "320 at 30: $(cat "$WORK/mode.err")"
+json_check "$WORK/mode.json" 'd["components"][0]["details"]["width"] == 320'
 echo "garbage" >"$WORK/bad.oni"
 if "$SKELGRAPH" oni mend "$WORK/bad.oni" 2>"$WORK/e4"; then fail "garbage mended"; fi
 grep -q "not an OpenNI recording" "$WORK/e4" || fail "garbage message: $(cat "$WORK/e4")"

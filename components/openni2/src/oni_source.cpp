@@ -85,6 +85,7 @@ void OniSource::open_device() {
   if (impl_->depth.create(impl_->device, openni::SENSOR_DEPTH) != openni::STATUS_OK) {
     throw std::runtime_error(oni_error("openni2: no depth stream on '" + opt_.uri + "'"));
   }
+  if ((opt_.width > 0 || opt_.height > 0 || opt_.fps > 0) && !impl_->device.isFile()) choose_mode();
   const openni::VideoMode mode = impl_->depth.getVideoMode();
   if (mode.getPixelFormat() != openni::PIXEL_FORMAT_DEPTH_1_MM && mode.getPixelFormat() != openni::PIXEL_FORMAT_DEPTH_100_UM) {
     throw std::runtime_error("openni2: '" + opt_.uri + "' delivers depth in pixel format " +
@@ -112,6 +113,36 @@ void OniSource::open_device() {
   frames_this_pass_ = 0;
   waited_ms_ = 0;
   at_end_ = false;
+}
+
+void OniSource::choose_mode() {
+  const auto matches = [&](const openni::VideoMode& m) {
+    const bool depth_format = m.getPixelFormat() == openni::PIXEL_FORMAT_DEPTH_1_MM ||
+                              m.getPixelFormat() == openni::PIXEL_FORMAT_DEPTH_100_UM;
+    return depth_format && (opt_.width <= 0 || m.getResolutionX() == opt_.width) &&
+           (opt_.height <= 0 || m.getResolutionY() == opt_.height) && (opt_.fps <= 0 || m.getFps() == opt_.fps);
+  };
+  const auto describe = [](const openni::VideoMode& m) {
+    return std::to_string(m.getResolutionX()) + "x" + std::to_string(m.getResolutionY()) + "@" +
+           std::to_string(m.getFps()) + (m.getPixelFormat() == openni::PIXEL_FORMAT_DEPTH_1_MM ? " mm" : "");
+  };
+  if (matches(impl_->depth.getVideoMode())) return;  // already so
+  const auto& modes = impl_->depth.getSensorInfo().getSupportedVideoModes();
+  std::string offered;
+  for (int i = 0; i < modes.getSize(); ++i) {
+    if (matches(modes[i])) {
+      if (impl_->depth.setVideoMode(modes[i]) != openni::STATUS_OK) {
+        throw std::runtime_error(oni_error("openni2: '" + opt_.uri + "' refused depth mode " + describe(modes[i])));
+      }
+      return;
+    }
+    offered += (offered.empty() ? "" : ", ") + describe(modes[i]);
+  }
+  const std::string want = (opt_.width > 0 ? std::to_string(opt_.width) : "any") + "x" +
+                           (opt_.height > 0 ? std::to_string(opt_.height) : "any") + "@" +
+                           (opt_.fps > 0 ? std::to_string(opt_.fps) : "any");
+  throw std::runtime_error("openni2: '" + opt_.uri + "' has no depth mode " + want + " (it offers: " +
+                           (offered.empty() ? describe(impl_->depth.getVideoMode()) : offered) + ")");
 }
 
 void OniSource::close_device() {

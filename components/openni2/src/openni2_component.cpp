@@ -19,6 +19,9 @@ runtime::ComponentInfo OpenNI2Component::describe() {
       .add_bool("repeat", false, "recordings: start again at the end")
       .add_string("record_directory", "",
                   "record each sync session (START..STOP) of a device to DIR/<sensor_id>_session<N>.oni (empty: off)")
+      .add_int("width", 0, "devices: depth image width to ask for (0: the device's default)", 0, 4096)
+      .add_int("height", 0, "devices: depth image height to ask for (0: the device's default)", 0, 4096)
+      .add_int("fps", 0, "devices: frame rate to ask for (0: the device's default)", 0, 1000)
       .add_bool("mend_recordings", true,
                 "make the recordings playable by OpenNI2's player when the device has no cropping property (Dummy)");
   return info;
@@ -31,6 +34,9 @@ OpenNI2Component::OpenNI2Component(runtime::Context& ctx, const runtime::Params&
   options_.speed = params.get<double>("speed");
   options_.repeat = params.get<bool>("repeat");
   options_.mend_recordings = params.get<bool>("mend_recordings");
+  options_.width = static_cast<int>(params.get<std::int64_t>("width"));
+  options_.height = static_cast<int>(params.get<std::int64_t>("height"));
+  options_.fps = static_cast<int>(params.get<std::int64_t>("fps"));
   record_dir_ = params.get<std::string>("record_directory");
   source_ = std::make_unique<OniSource>(options_);
   finite_ = source_->is_file() && !options_.repeat;

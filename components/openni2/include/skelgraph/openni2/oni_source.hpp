@@ -32,6 +32,9 @@ struct OniOptions {
   double speed = 1.0;           // recordings: 1 real time, 2 twice as fast, 0 as fast as frames can be read
   bool repeat = false;          // recordings: start again at the end
   bool mend_recordings = true;  // stop_recording() runs oni_add_cropping() on the file
+  // Devices: the depth mode to ask for (0: the device's default); one it does
+  // not offer is an error listing the modes it does.
+  int width = 0, height = 0, fps = 0;
 };
 
 class OniSource {
@@ -72,6 +75,7 @@ class OniSource {
   struct Impl;
   void open_device();
   void close_device();
+  void choose_mode();
   OniOptions opt_;
   std::unique_ptr<Impl> impl_;
   calib::Intrinsics intrinsics_;
