@@ -29,6 +29,15 @@ skeleton::Skeleton person(double heading_deg, double x = 0.0) {
   pose.right_arm = sim::arm_forward();
   return sim::forward_kinematics(sim::BodyDimensions::from_height(1.75), pose);
 }
+// A sensor, its renderer, and a tracker that knows the sensor's pose.
+struct Rig {
+  explicit Rig(sim::SensorConfig c) : cfg(std::move(c)), r(cfg, depth::kinect_intrinsics(320, 240)) {
+    tracker.set_pose(cfg.world_from_sensor());
+  }
+  sim::SensorConfig cfg;
+  sim::DepthRenderer r;
+  depth_tracker::DepthTracker tracker;
+};
 depth::DepthImage shot(const sim::DepthRenderer& r, const std::vector<skeleton::Skeleton>& people, sim::Rng& rng,
                        std::int64_t t_ns) {
   auto img = r.render(people, {}, rng, 1.75, 1.1);
@@ -90,38 +99,32 @@ TEST(DepthTracker, SeenSideOnItDoesNotVouchForLeftAndRight) {
 }
 
 TEST(DepthTracker, AnEmptyRoomHasNobodyAndPeopleWhoLeaveAreForgotten) {
-  const auto cfg = sensor_at({0.0, 1.2, 2.5}, 180.0);
-  sim::DepthRenderer r(cfg, depth::kinect_intrinsics(320, 240));
-  depth_tracker::DepthTracker tracker;
-  tracker.set_pose(cfg.world_from_sensor());
+  Rig rig(sensor_at({0.0, 1.2, 2.5}, 180.0));
   sim::Rng rng(7);
-  for (int k = 0; k < 5; ++k) EXPECT_TRUE(tracker.track(shot(r, {}, rng, k * 33'000'000)).empty());  // walls, floor
+  for (int k = 0; k < 5; ++k) EXPECT_TRUE(rig.tracker.track(shot(rig.r, {}, rng, k * 33'000'000)).empty());  // walls, floor
   std::uint32_t first_id = 0;
   for (int k = 5; k < 15; ++k) {
-    const auto out = tracker.track(shot(r, {person(0.0)}, rng, k * 33'000'000));
+    const auto out = rig.tracker.track(shot(rig.r, {person(0.0)}, rng, k * 33'000'000));
     ASSERT_EQ(out.size(), 1u) << k;
     if (first_id == 0) first_id = out[0].person_id;
     EXPECT_EQ(out[0].person_id, first_id);  // one id while tracked
   }
   // Gone for a second (longer than lost_after_s), then back: a new person.
-  for (int k = 15; k < 45; ++k) EXPECT_TRUE(tracker.track(shot(r, {}, rng, k * 33'000'000)).empty());
-  const auto back = tracker.track(shot(r, {person(0.0)}, rng, 45 * 33'000'000));
+  for (int k = 15; k < 45; ++k) EXPECT_TRUE(rig.tracker.track(shot(rig.r, {}, rng, k * 33'000'000)).empty());
+  const auto back = rig.tracker.track(shot(rig.r, {person(0.0)}, rng, 45 * 33'000'000));
   ASSERT_EQ(back.size(), 1u);
   EXPECT_NE(back[0].person_id, first_id);
 }
 
 TEST(DepthTracker, TwoPeopleAreTwoSkeletons) {
-  const auto cfg = sensor_at({0.0, 1.2, 3.0}, 180.0);
-  sim::DepthRenderer r(cfg, depth::kinect_intrinsics(320, 240));
-  depth_tracker::DepthTracker tracker;
-  tracker.set_pose(cfg.world_from_sensor());
+  Rig rig(sensor_at({0.0, 1.2, 3.0}, 180.0));
   sim::Rng rng(8);
   std::vector<skeleton::Skeleton> out;
-  for (int k = 0; k < 5; ++k) out = tracker.track(shot(r, {person(0.0, -0.7), person(0.0, 0.7)}, rng, k * 33'000'000));
+  for (int k = 0; k < 5; ++k) out = rig.tracker.track(shot(rig.r, {person(0.0, -0.7), person(0.0, 0.7)}, rng, k * 33'000'000));
   ASSERT_EQ(out.size(), 2u);
   EXPECT_NE(out[0].person_id, out[1].person_id);
-  const double x0 = (cfg.world_from_sensor() * out[0][JointId::Torso].position).x();
-  const double x1 = (cfg.world_from_sensor() * out[1][JointId::Torso].position).x();
+  const double x0 = (rig.cfg.world_from_sensor() * out[0][JointId::Torso].position).x();
+  const double x1 = (rig.cfg.world_from_sensor() * out[1][JointId::Torso].position).x();
   EXPECT_NEAR(std::abs(x0 - x1), 1.4, 0.1);
 }
 

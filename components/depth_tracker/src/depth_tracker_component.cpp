@@ -85,7 +85,6 @@ DepthTrackerComponent::DepthTrackerComponent(runtime::Context& ctx, const runtim
 
 void DepthTrackerComponent::on_depth_merged(depth::DepthImage image, std::int64_t receive_ns) {
   std::vector<skeleton::Skeleton> people;
-  std::uint32_t views = 0;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (poses_.find(image.sensor_id) == poses_.end()) {
@@ -109,7 +108,6 @@ void DepthTrackerComponent::on_depth_merged(depth::DepthImage image, std::int64_
       images.push_back(entry.second);
       poses.push_back(poses_.at(sensor));
     }
-    views = static_cast<std::uint32_t>(images.size());
     const auto t0 = std::chrono::steady_clock::now();
     people = merged_->track_merged(images, poses, merged_id_);
     merged_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -128,7 +126,6 @@ void DepthTrackerComponent::on_depth_merged(depth::DepthImage image, std::int64_
   f.frame_number(merged_fits_);
   f.people(static_cast<std::uint32_t>(people.size()));
   frame_pub_.publish(f);
-  (void)views;
 }
 
 void DepthTrackerComponent::on_depth(const msg::DepthFrame& frame) {

@@ -398,7 +398,6 @@ std::vector<skeleton::Skeleton> DepthTracker::Impl::step(std::vector<PersonPoint
     // Which way they face is not known: fit a standing template turned every
     // 45 degrees and keep the best (facing the sensor wins ties).
     Fit best_fit;
-    Pose best_pose{};
     for (int k = 0; k < 8; ++k) {
       const double a = k * M_PI / 4.0;
       const Vector3d fwd = Eigen::AngleAxisd(a, Vector3d::UnitY()) * to_sensor;
@@ -414,7 +413,6 @@ std::vector<skeleton::Skeleton> DepthTracker::Impl::step(std::vector<PersonPoint
         p.support = trial.support;
       }
     }
-    (void)best_pose;
     // Arms need not hang at the start: try each arm down, forward, out, up and
     // in between, and keep what explains the points best.
     const Vector3d up = Vector3d::UnitY();
