@@ -189,3 +189,56 @@ TEST(DepthTracker, OnTheSimulatedPointScenarioOneSensorStaysUnderTenCentimetres)
   EXPECT_GT(s.with_output, s.ticks * 9 / 10);
   EXPECT_LT(s.accuracy.mean_error_cm(), 10.0);
 }
+
+TEST(DepthTracker, JointLimitsCheckFoldedElbowsAndBackwardKnees) {
+  auto s = person(0.0);
+  EXPECT_FALSE(depth_tracker::check_joint_limits(s).any());
+  // Fold the right forearm back onto the upper arm: 10 degrees at the elbow.
+  const Eigen::Vector3d sh = s[JointId::RightShoulder].position, el = s[JointId::RightElbow].position;
+  const Eigen::Vector3d upper = (sh - el).normalized();
+  const Eigen::Vector3d side = upper.cross(Eigen::Vector3d::UnitX()).normalized();
+  s[JointId::RightHand].position = el + 0.25 * (std::cos(0.1745) * upper + std::sin(0.1745) * side);
+  auto v = depth_tracker::check_joint_limits(s);
+  EXPECT_NEAR(v.elbow_deg, 20.0, 0.5);
+  EXPECT_EQ(v.knee_back_m, 0.0);
+  // Push the left knee 10 cm backwards (the person faces +z).
+  s = person(0.0);
+  s[JointId::LeftKnee].position.z() -= 0.10;
+  v = depth_tracker::check_joint_limits(s);
+  EXPECT_NEAR(v.knee_back_m, 0.08, 0.005);
+  EXPECT_EQ(v.elbow_deg, 0.0);
+}
+
+TEST(DepthTracker, FitsKeepTheJointLimitsThatTheTruthKeeps) {
+  // Walking and arm movements seen by one sensor: frames whose fit breaks a
+  // limit (by more than a little) with the limits on and off.
+  const auto broken = [](double limit_weight, const std::string& scenario) {
+    sim::SimConfig cfg;
+    cfg.scenario.name = scenario;
+    cfg.sensors = sim::default_sensors(1);
+    depth_tracker::SimDepthOptions o;
+    o.intrinsics = depth::kinect_intrinsics(160, 120);
+    o.girth = 1.2;
+    o.tracker.limit_weight = limit_weight;
+    const auto r = depth_tracker::track_simulated_depth(cfg, o);
+    depth_tracker::JointLimits loose;  // what counts as broken: 5 degrees / 1 cm past the limits
+    loose.min_elbow_deg -= 5;
+    loose.min_knee_deg -= 5;
+    loose.knee_back_m += 0.01;
+    std::array<int, 2> n{};  // truth, tracked
+    for (const auto& e : r.events) {
+      n[e.kind == eval::TimedSkeleton::Kind::Truth ? 0 : 1] += depth_tracker::check_joint_limits(e.skeleton, loose).any();
+    }
+    return n;
+  };
+  for (const auto* scenario : {"walk", "arms"}) {
+    const auto on = broken(depth_tracker::TrackerOptions{}.limit_weight, scenario);
+    const auto off = broken(0.0, scenario);
+    std::printf("%s: truth %d, tracked with limits %d, without %d frames breaking a limit\n", scenario, on[0], on[1],
+                off[1]);
+    EXPECT_EQ(on[0], 0) << scenario;  // the simulator's people keep them
+    // Soft limits (penalties): a rare frame may still be past them, far fewer than without.
+    EXPECT_LE(on[1], 5) << scenario;
+    EXPECT_LE(20 * on[1], off[1]) << scenario;
+  }
+}

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <initializer_list>
 #include <map>
 #include <memory>
 #include <stdexcept>
@@ -118,6 +119,41 @@ Pose standing(double h, const Vector3d& centre, const Vector3d& fwd) {
 
 Vector3d pelvis_of(const Pose& p) { return 0.5 * (p[idx(JointId::LeftHip)] + p[idx(JointId::RightHip)]); }
 
+// The way the hips and trunk face (the body's own up, crossed with its left).
+Vector3d body_forward(const Pose& p) {
+  const Vector3d up = p[idx(JointId::Neck)] - pelvis_of(p);
+  const Vector3d left = p[idx(JointId::LeftHip)] - p[idx(JointId::RightHip)];
+  const Vector3d fwd = left.cross(up);
+  return fwd.norm() > 1e-9 ? Vector3d(fwd.normalized()) : Vector3d::Zero();
+}
+
+// Arms and legs: root, middle (the hinge) and end joints.
+struct Limb {
+  std::array<std::size_t, 3> joints;
+  bool knee;
+};
+const std::array<Limb, 4>& limbs() {
+  using J_ = JointId;
+  static const std::array<Limb, 4> l = {{
+      {{idx(J_::LeftShoulder), idx(J_::LeftElbow), idx(J_::LeftHand)}, false},
+      {{idx(J_::RightShoulder), idx(J_::RightElbow), idx(J_::RightHand)}, false},
+      {{idx(J_::LeftHip), idx(J_::LeftKnee), idx(J_::LeftFoot)}, true},
+      {{idx(J_::RightHip), idx(J_::RightKnee), idx(J_::RightFoot)}, true},
+  }};
+  return l;
+}
+
+// Adds w r^2 to the Gauss-Newton system, r depending on up to three joints
+// with gradients g (dr/dx_joint): A += w J^T J, b -= w J^T r.
+void add_residual(Mat& A, Vec& b, std::initializer_list<std::pair<std::size_t, Vector3d>> grad, double r, double w) {
+  for (const auto& [jk, gk] : grad) {
+    for (const auto& [jl, gl] : grad) {
+      A.block<3, 3>(3 * static_cast<int>(jk), 3 * static_cast<int>(jl)) += w * gk * gl.transpose();
+    }
+    b.segment<3>(3 * static_cast<int>(jk)) -= w * gk * r;
+  }
+}
+
 struct Person {
   std::uint32_t id = 0;
   double height = 1.75;
@@ -136,6 +172,23 @@ double closest_fraction(const Vector3d& a, const Vector3d& b, const Vector3d& p)
 }
 
 }  // namespace
+
+LimitViolation check_joint_limits(const skeleton::Skeleton& s, const JointLimits& limits) {
+  Pose x;
+  for (std::size_t k = 0; k < kJ; ++k) x[k] = s.joints[k].position;
+  const Vector3d fwd = body_forward(x);
+  LimitViolation v;
+  for (const auto& limb : limbs()) {
+    const auto [a, m, e] = limb.joints;
+    const Vector3d u = x[a] - x[m], w = x[e] - x[m];
+    if (u.norm() < 1e-9 || w.norm() < 1e-9) continue;
+    const double angle = std::acos(std::clamp(u.normalized().dot(w.normalized()), -1.0, 1.0)) * 180.0 / M_PI;
+    double& worst = limb.knee ? v.knee_deg : v.elbow_deg;
+    worst = std::max(worst, (limb.knee ? limits.min_knee_deg : limits.min_elbow_deg) - angle);
+    if (limb.knee) v.knee_back_m = std::max(v.knee_back_m, -(x[m] - 0.5 * (x[a] + x[e])).dot(fwd) - limits.knee_back_m);
+  }
+  return v;
+}
 
 struct DepthTracker::Impl {
   TrackerOptions opt;
@@ -157,7 +210,7 @@ struct DepthTracker::Impl {
 
 DepthTracker::DepthTracker(TrackerOptions options) : impl_(std::make_unique<Impl>()) {
   if (!(options.voxel_m > 0) || options.iterations < 1 || options.init_iterations < 1 || !(options.outlier_m > 0) ||
-      !(options.bone_weight >= 0) || !(options.smooth_weight >= 0) || !(options.max_height_m > options.min_height_m)) {
+      !(options.bone_weight >= 0) || !(options.smooth_weight >= 0) || !(options.limit_weight >= 0) || !(options.max_height_m > options.min_height_m)) {
     throw std::invalid_argument("depth tracker: bad options");
   }
   impl_->opt = options;
@@ -243,14 +296,30 @@ DepthTracker::Impl::Fit DepthTracker::Impl::fit(Person& person, const depth::Poi
       const double len = d.norm();
       if (len < 1e-9) continue;
       const Vector3d u = d / len;
-      const double e = len - person.lengths[l];
-      const Eigen::Matrix3d uu = opt.bone_weight * u * u.transpose();
-      A.block<3, 3>(3 * static_cast<int>(i), 3 * static_cast<int>(i)) += uu;
-      A.block<3, 3>(3 * static_cast<int>(j), 3 * static_cast<int>(j)) += uu;
-      A.block<3, 3>(3 * static_cast<int>(i), 3 * static_cast<int>(j)) -= uu;
-      A.block<3, 3>(3 * static_cast<int>(j), 3 * static_cast<int>(i)) -= uu;
-      b.segment<3>(3 * static_cast<int>(i)) -= opt.bone_weight * u * e;
-      b.segment<3>(3 * static_cast<int>(j)) += opt.bone_weight * u * e;
+      add_residual(A, b, {{i, u}, {j, -u}}, len - person.lengths[l], opt.bone_weight);
+    }
+    // Joint limits, where broken.
+    if (opt.limit_weight > 0) {
+      const Vector3d fwd = body_forward(x);
+      for (const auto& limb : limbs()) {
+        const auto [a, m, e] = limb.joints;
+        const double l1 = (x[a] - x[m]).norm(), l2 = (x[m] - x[e]).norm();
+        const double fold = (limb.knee ? opt.limits.min_knee_deg : opt.limits.min_elbow_deg) * M_PI / 180.0;
+        const double reach_min = std::sqrt(std::max(0.0, l1 * l1 + l2 * l2 - 2 * l1 * l2 * std::cos(fold)));
+        const Vector3d ae = x[e] - x[a];
+        const double reach = ae.norm();
+        if (reach < reach_min && reach > 1e-9) {
+          const Vector3d u = ae / reach;
+          add_residual(A, b, {{e, u}, {a, -u}}, reach - reach_min, opt.limit_weight);
+        }
+        if (limb.knee) {
+          const double ahead = (x[m] - 0.5 * (x[a] + x[e])).dot(fwd);
+          if (ahead < -opt.limits.knee_back_m) {
+            add_residual(A, b, {{m, fwd}, {a, -0.5 * fwd}, {e, -0.5 * fwd}}, ahead + opt.limits.knee_back_m,
+                         opt.limit_weight);
+          }
+        }
+      }
     }
     // Towards the previous frame's pose, and a little damping.
     for (std::size_t k = 0; k < kJ; ++k) {

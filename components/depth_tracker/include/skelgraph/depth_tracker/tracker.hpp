@@ -9,7 +9,9 @@
 // Gauss-Newton, the distance of each point to the surface of its nearest
 // capsule (robust: far points are ignored, mid ones down-weighted), plus the
 // deviation of bone lengths (and the trunk's shape) from the person's, plus
-// a pull towards the previous pose. A new person starts from a standing
+// a pull towards the previous pose, plus penalties for joint limits broken
+// (JointLimits: elbows and knees not folded too tight, knees not bent
+// backwards). A new person starts from a standing
 // template facing the sensor, scaled to the height of their region; a person
 // not seen for `lost_after_s` is dropped and starts again when found.
 // Per-joint confidence: 1 when enough points support the joint's segments,
@@ -34,6 +36,16 @@
 
 namespace skelgraph::depth_tracker {
 
+// What a body can do, as the fit enforces it: elbows and knees bend no
+// tighter than these angles (between the two bones meeting there: 180 is
+// straight), and knees bend forwards only (the knee no more than
+// `knee_back_m` behind the hip-foot line, "forwards" being the way the
+// hips and trunk face).
+struct JointLimits {
+  double min_elbow_deg = 30.0;
+  double min_knee_deg = 40.0;
+  double knee_back_m = 0.02;
+};
 struct TrackerOptions {
   double voxel_m = 0.03;           // the person's points are thinned to one per cube of this side
   int iterations = 6;              // Gauss-Newton steps per frame
@@ -52,7 +64,17 @@ struct TrackerOptions {
   double match_radius_m = 0.7;     // a region continues a person whose pelvis was this close
   double lost_after_s = 0.5;
   double tracked_support = 8;      // points on a joint's segments for confidence 1
+  JointLimits limits;
+  double limit_weight = 200.0;     // per broken limit, against one point; 0 turns the limits off
 };
+
+// How far a skeleton breaks the limits: the worst amount per limit (0 when
+// kept). Frame-free (uses the body's own up and forward).
+struct LimitViolation {
+  double elbow_deg = 0.0, knee_deg = 0.0, knee_back_m = 0.0;
+  bool any() const { return elbow_deg > 0 || knee_deg > 0 || knee_back_m > 0; }
+};
+LimitViolation check_joint_limits(const skeleton::Skeleton& s, const JointLimits& limits = {});
 
 struct TrackerStats {
   std::uint64_t frames = 0, regions = 0, people_reported = 0, initialisations = 0;
