@@ -35,6 +35,16 @@ const char* to_string(ComponentState s) {
   return "UNKNOWN";
 }
 
+const char* to_string(PlayKind k) {
+  switch (k) {
+    case PLAY_PAUSE: return "PAUSE";
+    case PLAY_RESUME: return "RESUME";
+    case PLAY_STEP: return "STEP";
+    case PLAY_SPEED: return "SPEED";
+  }
+  return "UNKNOWN";
+}
+
 void to_json(nlohmann::json& j, const Vec3& v) { j = {{"x", v.x()}, {"y", v.y()}, {"z", v.z()}}; }
 void to_json(nlohmann::json& j, const Quat& q) {
   j = {{"w", q.w()}, {"x", q.x()}, {"y", q.y()}, {"z", q.z()}};
@@ -150,6 +160,16 @@ void to_json(nlohmann::json& j, const ComponentStatus& v) {
        {"host", v.host()},                     {"stamp_ns", v.stamp_ns()},
        {"state", to_string(v.state())},        {"message", v.message()},
        {"topics", v.topics()}};
+}
+
+void to_json(nlohmann::json& j, const PlayControl& v) {
+  j = {{"target", v.target().to_string()}, {"kind", to_string(v.kind())}, {"value", v.value()},
+       {"request_id", v.request_id().to_string()}};
+}
+void to_json(nlohmann::json& j, const PlayState& v) {
+  j = {{"player", v.player().to_string()}, {"paused", v.paused()},     {"speed", v.speed()},
+       {"frames", v.frames()},             {"frame_count", v.frame_count()}, {"at_end", v.at_end()},
+       {"request_id", v.request_id().to_string()}, {"error", v.error().to_string()}};
 }
 
 }  // namespace skelgraph::msg

@@ -2,7 +2,8 @@
 # The OpenNI2 path on the Dummy device: live depth at 30 Hz on skelgraph/depth;
 # sync sessions recorded to .oni; Debian's player delivering no frame of an
 # unmended Dummy recording (pinned), `oni mend` fixing it; recordings played
-# back frame for frame by the component; clear errors for bad URIs.
+# back frame for frame by the component, paused, stepped and sped up with
+# `skelgraph player`; clear errors for bad URIs.
 source "$(dirname "$0")/lib.sh"
 
 # 1. Live, with a sync master: two sessions recorded (the first left unmended on purpose).
@@ -54,6 +55,31 @@ start=$SECONDS
 "$SKELGRAPH" run openni2 -p uri="$WORK/mended.oni" --duration 30 --json >"$WORK/play1.json" 2>"$WORK/play1.err" || fail "play: $(cat "$WORK/play1.err")"
 json_check "$WORK/play1.json" 'abs(d["duration_s"] - '"$frames"' / 30.0) < 1.5'
 ok "played back $frames frames fast and in $(json_get "$WORK/play1.json" 'round(d["duration_s"], 1)') s at speed 1"
+
+# 3b. A paused player delivers exactly the frames a step asks for, holds, then plays on at a new speed.
+"$SKELGRAPH" run openni2 --name player1 -p uri="$WORK/mended.oni" -p paused=true --duration 40 --json \
+  >"$WORK/step.json" 2>"$WORK/step.err" &
+player=$!
+"$SKELGRAPH" player state --target player1 --json --timeout 10 >"$WORK/st0.json" || fail "player state: $(cat "$WORK/step.err")"
+json_check "$WORK/st0.json" 'd[0]["paused"] and d[0]["frames"] == 0 and d[0]["frame_count"] == '"$frames"
+"$SKELGRAPH" topic echo skelgraph/depth --count 3 --json --timeout 15 >"$WORK/steps.jsonl" 2>"$WORK/steps.err" &
+echo_pid=$!
+sleep 2  # the echo's reader matched
+"$SKELGRAPH" player step --frames 3 --target player1 --json >"$WORK/st1.json" || fail "step"
+json_check "$WORK/st1.json" 'd[0]["paused"] and d[0]["frames"] == 3 and d[0]["error"] == ""'
+wait "$echo_pid" || fail "echo of the stepped frames: $(cat "$WORK/steps.err")"
+python3 -c 'import json, sys; n = [json.loads(l)["data"]["frame_number"] for l in open(sys.argv[1])]; sys.exit(n != [1, 2, 3])' \
+  "$WORK/steps.jsonl" || fail "stepped frames: $(cut -c1-200 "$WORK/steps.jsonl")"
+sleep 1
+"$SKELGRAPH" player state --target player1 --json >"$WORK/st2.json"
+json_check "$WORK/st2.json" 'd[0]["frames"] == 3'  # paused: nothing more
+if "$SKELGRAPH" player speed 2000 --target player1 2>/dev/null; then fail "speed 2000 accepted"; fi
+"$SKELGRAPH" player speed 0 --target player1 --json >"$WORK/st3.json"
+json_check "$WORK/st3.json" 'd[0]["speed"] == 0 and d[0]["paused"]'
+"$SKELGRAPH" player resume --target player1 >/dev/null
+wait "$player" || fail "player: $(cat "$WORK/step.err")"
+json_check "$WORK/step.json" 'd["components"][0]["details"]["published"] == '"$frames"
+ok "stepped 3 frames (numbers 1-2-3), held while paused, then played the other $((frames - 3)) at speed 0"
 
 # 4. Errors a user can act on.
 if "$SKELGRAPH" run openni2 -p uri=Dumy --duration 1 >/dev/null 2>"$WORK/e1"; then fail "bad URI accepted"; fi

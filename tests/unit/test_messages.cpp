@@ -65,7 +65,8 @@ TEST(Messages, SyncCommandDecodesWithKindName) {
 TEST(Messages, TableCoversEveryTopLevelTypeOnce) {
   const std::vector<std::string> expected = {"Skeleton",   "SyncCommand",  "SyncControl", "SyncAck",
                                              "SensorPose", "DepthFrame",   "GestureEvent", "ComponentStatus",
-                                             "ClockOffset", "TickFrames", "SensorFrame", "GestureState", "PointCloud"};
+                                             "ClockOffset", "TickFrames", "SensorFrame", "GestureState", "PointCloud",
+                                             "PlayControl", "PlayState"};
   ASSERT_EQ(message_table().size(), expected.size());
   for (const auto& name : expected) {
     const auto* info = find_message("skelgraph::msg::" + name);

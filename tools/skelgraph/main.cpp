@@ -107,6 +107,7 @@ int main(int argc, char** argv) {
   add_play_data_command(app, g, run);
   add_topic_command(app, g, run);
   add_sync_command(app, g, run);
+  add_player_command(app, g, run);
   add_demo_command(app, g, run);
   add_components_command(app, g, run);
   add_sim_command(app, g, run);

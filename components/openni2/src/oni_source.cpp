@@ -237,10 +237,12 @@ std::optional<depth::DepthImage> OniSource::next(std::chrono::milliseconds timeo
     if (recording()) ++recorded_;
     return image;
   }
-  // Recordings: the recorded timing, scaled by the speed, from this pass's first frame.
-  if (frames_read_ == 1) {
+  // Recordings: the recorded timing, scaled by the speed, from the first
+  // frame (or the first since the speed changed or pacing restarted).
+  if (repace_) {
     pace_start_ns_ = host_now_ns();
     pace_first_ts_us_ = ts;
+    repace_ = false;
   }
   const std::int64_t since_us = static_cast<std::int64_t>(ts - pace_first_ts_us_);
   if (opt_.speed > 0) {
@@ -251,6 +253,12 @@ std::optional<depth::DepthImage> OniSource::next(std::chrono::milliseconds timeo
     image.stamp_ns = host_now_ns();
   }
   return image;
+}
+
+void OniSource::set_speed(double speed) {
+  if (!(speed >= 0) || !std::isfinite(speed)) throw std::invalid_argument("openni2: speed must be >= 0");
+  opt_.speed = speed;
+  repace_ = true;
 }
 
 void OniSource::start_recording(const std::string& path) {

@@ -1,6 +1,8 @@
 #include "skelgraph/openni2/openni2_component.hpp"
 
+#include <algorithm>
 #include <sstream>
+#include <utility>
 
 #include "skelgraph/depth/depth_msg.hpp"
 
@@ -17,6 +19,7 @@ runtime::ComponentInfo OpenNI2Component::describe() {
       .add_string("sensor_id", "depth1", "the sensor's name on skelgraph/depth")
       .add_double("speed", 1.0, "recordings: 1 real time, 2 twice as fast, 0 as fast as possible", 0.0, 100.0)
       .add_bool("repeat", false, "recordings: start again at the end")
+      .add_bool("paused", false, "recordings: start paused (then `skelgraph play step|resume`)")
       .add_string("record_directory", "",
                   "record each sync session (START..STOP) of a device to DIR/<sensor_id>_session<N>.oni (empty: off)")
       .add_int("width", 0, "devices: depth image width to ask for (0: the device's default)", 0, 4096)
@@ -41,6 +44,14 @@ OpenNI2Component::OpenNI2Component(runtime::Context& ctx, const runtime::Params&
   source_ = std::make_unique<OniSource>(options_);
   finite_ = source_->is_file() && !options_.repeat;
   description_ = source_->description();
+  if (source_->is_file()) {
+    gate_ = runtime::PlayGate(options_.speed, params.get<bool>("paused"));
+    state_pub_ = std::make_unique<runtime::Publisher<msg::PlayState>>(ctx, runtime::topics::kPlayState);
+    play_sub_ = std::make_unique<runtime::Subscription<msg::PlayControl>>(
+        ctx, runtime::topics::kPlayControl, [this](const msg::PlayControl& c, const runtime::SampleMeta&) { on_play(c); });
+  } else if (params.get<bool>("paused")) {
+    throw std::invalid_argument("openni2: paused is for recordings, not devices");
+  }
   if (!record_dir_.empty()) {
     if (source_->is_file()) throw std::invalid_argument("openni2: record_directory is for devices, not recordings");
     sync_sub_ = std::make_unique<runtime::Subscription<msg::SyncCommand>>(
@@ -58,6 +69,7 @@ void OpenNI2Component::on_start() {
     ctx_.set_health(runtime::HealthState::Ok,
                     "the device reports no field of view: Kinect-like intrinsics assumed");
   }
+  if (state_pub_) publish_state("", "");
   thread_ = std::thread([this] { run(); });
 }
 
@@ -76,6 +88,47 @@ void OpenNI2Component::on_sync(const msg::SyncCommand& cmd, bool session_topic) 
   } else if (cmd.kind() == msg::SYNC_STOP && session_topic) {
     last_stopped_ = cmd.session_id();  // a late joiner: that session is over
   }
+}
+
+void OpenNI2Component::on_play(const msg::PlayControl& c) {
+  const std::string target = c.target().to_string(), id = c.request_id().to_string();
+  if (!target.empty() && target != ctx_.name()) return;
+  std::string error;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!id.empty()) {
+      if (std::find(handled_requests_.begin(), handled_requests_.end(), id) != handled_requests_.end()) return;
+      handled_requests_.push_back(id);
+      if (handled_requests_.size() > 32) handled_requests_.pop_front();
+    }
+    using K = runtime::PlayGate::Kind;
+    const K kind = c.kind() == msg::PLAY_PAUSE    ? K::Pause
+                   : c.kind() == msg::PLAY_RESUME ? K::Resume
+                   : c.kind() == msg::PLAY_STEP   ? K::Step
+                                                  : K::Speed;
+    error = gate_.apply(kind, c.value());
+    if (error.empty() && kind == K::Step) {
+      step_request_ = id;  // answered once the frames are out
+      return;
+    }
+  }
+  publish_state(id, error);
+}
+
+void OpenNI2Component::publish_state(const std::string& request_id, const std::string& error) {
+  msg::PlayState s;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    s.player(ctx_.name().substr(0, 64));
+    s.paused(gate_.paused());
+    s.speed(gate_.speed());
+    s.frames(published_);
+    s.frame_count(source_->frame_count());
+    s.at_end(finished_);
+    s.request_id(request_id.substr(0, 64));
+    s.error(error.substr(0, 128));
+  }
+  state_pub_->publish(s);
 }
 
 void OpenNI2Component::run() {
@@ -104,14 +157,45 @@ void OpenNI2Component::run() {
           recording_session_ = *want;
         }
       }
+      if (state_pub_) {
+        // A player: wait while paused; steps come without waiting; a new speed
+        // or a resume paces afresh from the next frame.
+        bool deliver = false, repace = false, stepping = false;
+        double speed = 1.0;
+        {
+          std::lock_guard<std::mutex> lock(mutex_);
+          deliver = gate_.may_deliver();
+          repace = gate_.take_repace();
+          stepping = gate_.paused();
+          speed = gate_.speed();
+        }
+        if (!deliver) {
+          std::this_thread::sleep_for(std::chrono::milliseconds(5));
+          continue;
+        }
+        if (repace || stepping) source_->set_speed(speed);
+      }
       auto image = source_->next(std::chrono::milliseconds(100));
       if (image) {
         depth_pub_.publish(depth::to_msg(std::move(*image)));
-        std::lock_guard<std::mutex> lock(mutex_);
-        ++published_;
+        std::string answer;
+        {
+          std::lock_guard<std::mutex> lock(mutex_);
+          ++published_;
+          if (gate_.delivered()) answer = std::exchange(step_request_, "");
+        }
+        if (!answer.empty()) publish_state(answer, "");
       } else if (source_->at_end()) {
         finished_ = true;
         ctx_.set_health(runtime::HealthState::Ok, "end of recording");
+        if (state_pub_) {
+          std::string pending;
+          {
+            std::lock_guard<std::mutex> lock(mutex_);
+            pending = std::exchange(step_request_, "");
+          }
+          publish_state(pending, pending.empty() ? "" : "the recording ended before the steps were done");
+        }
         break;
       }
     }
@@ -154,6 +238,8 @@ nlohmann::json OpenNI2Component::details() const {
           {"intrinsics_from_device", source_->intrinsics_from_device()},
           {"frames_in_recording", source_->frame_count()},
           {"published", published_},
+          {"paused", gate_.paused()},
+          {"speed", state_pub_ ? gate_.speed() : 0.0},
           {"recordings", files_},
           {"recorded_frames", files_frames_},
           {"error", error_}};

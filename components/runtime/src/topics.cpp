@@ -15,6 +15,7 @@ const std::vector<TopicInfo>& known_topics() {
       info(topics::kSyncAck),      info(topics::kSyncClock),      info(topics::kSkeletonRaw),   info(topics::kSensorFrame),   info(topics::kSkeletonFused),
       info(topics::kSkeletonTruth), info(topics::kDepth),        info(topics::kCalibration),
       info(topics::kGestureEvent), info(topics::kGestureState), info(topics::kCloud),
+      info(topics::kPlayControl), info(topics::kPlayState),
       info(topics::kStatus)};
   return table;
 }

@@ -33,10 +33,13 @@ void to_json(nlohmann::json& j, const DepthFrame& v);
 void to_json(nlohmann::json& j, const GestureEvent& v);
 void to_json(nlohmann::json& j, const GestureState& v);
 void to_json(nlohmann::json& j, const PointCloud& v);
+void to_json(nlohmann::json& j, const PlayControl& v);
+void to_json(nlohmann::json& j, const PlayState& v);
 void to_json(nlohmann::json& j, const TopicStats& v);
 void to_json(nlohmann::json& j, const ComponentStatus& v);
 
 const char* to_string(SyncKind k);
 const char* to_string(ComponentState s);
+const char* to_string(PlayKind k);
 
 }  // namespace skelgraph::msg

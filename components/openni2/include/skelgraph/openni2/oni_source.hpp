@@ -63,6 +63,12 @@ class OniSource {
   // scaled by the speed (files).
   std::optional<depth::DepthImage> next(std::chrono::milliseconds timeout);
   bool at_end() const { return at_end_; }
+  // Recordings: a new speed, paced from the next frame on (no burst to catch
+  // up, no wait for lost time); restart_pacing() alone does the latter (after
+  // a pause). Throws std::invalid_argument for a negative speed.
+  void set_speed(double speed);
+  void restart_pacing() { repace_ = true; }
+  double speed() const { return opt_.speed; }
   std::uint64_t frames_read() const { return frames_read_; }
 
   // Records the depth stream to an .oni file until stop_recording(), which
@@ -86,6 +92,7 @@ class OniSource {
   std::uint64_t frames_read_ = 0, frames_this_pass_ = 0, recorded_ = 0;
   std::int64_t pace_start_ns_ = 0;      // files: host time of the pass's first frame
   std::uint64_t pace_first_ts_us_ = 0;  // files: its recorded timestamp
+  bool repace_ = true;                  // files: the next frame starts the pacing afresh
   std::uint64_t pass_offset_ts_us_ = 0; // files: timestamps of earlier passes (repeat)
   std::uint64_t last_ts_us_ = 0;
   std::int64_t waited_ms_ = 0;          // files: waited for this pass's first frame

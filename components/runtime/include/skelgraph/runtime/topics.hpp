@@ -53,6 +53,10 @@ inline const TopicDef<msg::GestureEvent> kGestureEvent{"skelgraph/gesture/event"
 inline const TopicDef<msg::GestureState> kGestureState{"skelgraph/gesture/state", {R::Reliable, D::TransientLocal, 16}};
 // Thinned point clouds for viewers (the `cloud` component): the latest only.
 inline const TopicDef<msg::PointCloud> kCloud{"skelgraph/cloud", {R::BestEffort, D::Volatile, 1}};
+// Requests to players of recordings (skelgraph play ...), and each player's
+// state (keyed by player; late joiners get the latest).
+inline const TopicDef<msg::PlayControl> kPlayControl{"skelgraph/play/control", {R::Reliable, D::Volatile, 0}};
+inline const TopicDef<msg::PlayState> kPlayState{"skelgraph/play/state", {R::Reliable, D::TransientLocal, 16}};
 inline const TopicDef<msg::ComponentStatus> kStatus{"skelgraph/status", {R::BestEffort, D::Volatile, 1}};
 
 }  // namespace topics
