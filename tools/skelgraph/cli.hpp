@@ -24,6 +24,7 @@ struct GlobalOptions {
   std::optional<int> domain;
   std::optional<std::string> profile;
   std::vector<std::string> interfaces;
+  std::vector<std::string> discovery_servers;
   std::string log_level = "info";
 };
 

@@ -1,6 +1,7 @@
 // skelgraph launch FILE [--host NAME] [--duration S]
 
 #include <cstdio>
+#include <cstdlib>
 
 #include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
@@ -28,7 +29,10 @@ void add_launch_command(CLI::App& app, GlobalOptions& g, Action& run) {
       const auto registry = runtime::builtin_registry();
       const auto spec = runtime::parse_launch_file(o->file);
       const auto components = runtime::resolve_launch(spec, registry, o->host);
-      return run_graph(registry, make_config(g, &spec), components, o->run, nullptr);
+      auto config = make_config(g, &spec);
+      // The launch file's host name is this process's host in status and sync acks (unless SKELGRAPH_HOST says).
+      if (!o->host.empty() && std::getenv("SKELGRAPH_HOST") == nullptr) config.host = o->host;
+      return run_graph(registry, config, components, o->run, nullptr);
     };
   });
 }

@@ -25,6 +25,10 @@ runtime::DdsConfig make_config(const GlobalOptions& g, const runtime::LaunchSpec
   if (g.domain) c.domain = *g.domain;
   if (g.profile) c.profile = *g.profile;
   if (!g.interfaces.empty()) c.interfaces = g.interfaces;
+  if (!g.discovery_servers.empty()) {
+    for (const auto& a : g.discovery_servers) runtime::parse_server_address(a);
+    c.discovery_servers = g.discovery_servers;
+  }
   return c;
 }
 
@@ -55,6 +59,9 @@ void add_dds_options(CLI::App& cmd, GlobalOptions& g) {
   cmd.add_option("--profile", g.profile,
                  "DDS profile: loopback (default), lan, or a path to an XML file (env SKELGRAPH_PROFILE)");
   cmd.add_option("--interface", g.interfaces, "restrict UDP to this interface address (repeatable; lan profile)");
+  cmd.add_option("--discovery-server", g.discovery_servers,
+                 "discover through this server, IP:PORT (repeatable: the i-th is `fastdds discovery -i i`; "
+                 "lan-discovery-server profile; env SKELGRAPH_DISCOVERY_SERVERS)");
 }
 
 void block_signals() {

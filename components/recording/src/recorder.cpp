@@ -112,11 +112,16 @@ void Recorder::open(const std::string& label, std::uint32_t session_id) {
   }
 }
 
-void Recorder::stop_session() {
-  if (!session_ || linger_timer_active_) return;
-  if (linger_.count() == 0) return close();
+void Recorder::stop_session(std::chrono::milliseconds wait) {
+  if (!session_) return;
+  if (linger_timer_active_) {
+    if (wait >= linger_wait_) return;
+    linger_timer_.cancel();  // a sooner close: the STOP on the sync topic after the one on the session topic
+  }
+  if (wait.count() == 0) return close();
   linger_timer_active_ = true;
-  linger_timer_ = ctx_.executor().every(linger_, [this] { close(); });
+  linger_wait_ = wait;
+  linger_timer_ = ctx_.executor().every(wait, [this] { close(); });
 }
 
 void Recorder::close() {
@@ -170,7 +175,10 @@ void Recorder::on_sample(const runtime::TopicInfo& topic, bool keyed, const msg:
   }
   if (!sync || session_topic) {
     if (sync && session_topic && sync->kind() == msg::SYNC_STOP && !record_now_ && session_id_ == sync->session_id()) {
-      stop_session();
+      // The session topic can overtake the sync topic, whose last ticks may
+      // still be under repair on a lossy link: wait for the STOP there (it
+      // follows every tick), or close after a grace period if it never comes.
+      stop_session(std::max(linger_, kSessionStopGrace));
     }
     return;
   }
@@ -186,7 +194,7 @@ void Recorder::on_sample(const runtime::TopicInfo& topic, bool keyed, const msg:
     ack_pub_.publish(ack);
     ++ticks_acked_;
   } else if (sync->kind() == msg::SYNC_STOP && !record_now_) {
-    stop_session();
+    stop_session(linger_);
   }
 }
 

@@ -16,6 +16,8 @@
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
+#include <fastdds/rtps/attributes/ServerAttributes.h>
+#include <fastrtps/utils/IPLocator.h>
 
 #include "skelgraph/runtime/type_policy.hpp"
 
@@ -68,6 +70,26 @@ Context::Context(std::string name, const DdsConfig& config, dds::DomainParticipa
     if (!any_udp) {
       throw std::runtime_error("DDS profile '" + profile + "' has no UDPv4 transport to restrict to the given interfaces");
     }
+  }
+  auto& discovery = qos.wire_protocol().builtin.discovery_config;
+  for (std::size_t i = 0; i < config.discovery_servers.size(); ++i) {
+    const auto address = parse_server_address(config.discovery_servers[i]);
+    eprosima::fastrtps::rtps::RemoteServerAttributes server;
+    if (!eprosima::fastdds::rtps::get_server_client_default_guidPrefix(static_cast<int>(i), server.guidPrefix)) {
+      throw std::runtime_error("at most 256 discovery servers");
+    }
+    eprosima::fastrtps::rtps::Locator_t locator;
+    eprosima::fastrtps::rtps::IPLocator::setIPv4(locator, address.ip);
+    locator.port = static_cast<std::uint32_t>(address.port);
+    server.metatrafficUnicastLocatorList.push_back(locator);
+    discovery.discoveryProtocol = eprosima::fastrtps::rtps::DiscoveryProtocol_t::CLIENT;
+    discovery.m_DiscoveryServers.push_back(server);
+  }
+  if (discovery.discoveryProtocol == eprosima::fastrtps::rtps::DiscoveryProtocol_t::CLIENT &&
+      discovery.m_DiscoveryServers.empty()) {
+    throw std::runtime_error("DDS profile '" + profile +
+                             "' discovers through a discovery server: name it with --discovery-server IP:PORT or "
+                             "SKELGRAPH_DISCOVERY_SERVERS (start one with `fastdds discovery -i 0 -l IP -p PORT`)");
   }
   participant_ = factory->create_participant(static_cast<dds::DomainId_t>(config.domain), qos, listener,
                                              dds::StatusMask::none());

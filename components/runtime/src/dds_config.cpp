@@ -39,6 +39,16 @@ DdsConfig DdsConfig::from_env() {
       if (!item.empty()) c.interfaces.push_back(item);
     }
   }
+  if (const char* d = env("SKELGRAPH_DISCOVERY_SERVERS")) {
+    std::stringstream ss(d);
+    std::string item;
+    while (std::getline(ss, item, ',')) {
+      if (!item.empty()) {
+        parse_server_address(item);  // fail early, naming the variable's value
+        c.discovery_servers.push_back(item);
+      }
+    }
+  }
   if (const char* h = env("SKELGRAPH_HOST")) {
     c.host = h;
   } else {
@@ -46,6 +56,32 @@ DdsConfig DdsConfig::from_env() {
     c.host = gethostname(buf, sizeof(buf) - 1) == 0 ? buf : "unknown";
   }
   return c;
+}
+
+ServerAddress parse_server_address(const std::string& text) {
+  const auto colon = text.rfind(':');
+  const std::string what = "discovery server '" + text + "': expected IP:PORT (e.g. 192.0.2.10:11811)";
+  if (colon == std::string::npos || colon == 0) throw std::runtime_error(what);
+  ServerAddress a;
+  a.ip = text.substr(0, colon);
+  int parts = 0;
+  std::stringstream ss(a.ip);
+  std::string part;
+  while (std::getline(ss, part, '.')) {
+    if (part.empty() || part.size() > 3 || part.find_first_not_of("0123456789") != std::string::npos ||
+        std::stoi(part) > 255) {
+      throw std::runtime_error(what + ": '" + a.ip + "' is not an IPv4 address");
+    }
+    ++parts;
+  }
+  if (parts != 4 || a.ip.back() == '.') throw std::runtime_error(what + ": '" + a.ip + "' is not an IPv4 address");
+  const std::string port = text.substr(colon + 1);
+  if (port.empty() || port.size() > 5 || port.find_first_not_of("0123456789") != std::string::npos ||
+      std::stoi(port) < 1 || std::stoi(port) > 65535) {
+    throw std::runtime_error(what + ": port '" + port + "' is not 1..65535");
+  }
+  a.port = std::stoi(port);
+  return a;
 }
 
 std::string profiles_dir() {

@@ -60,6 +60,10 @@ WriterBase::WriterBase(Context& ctx, const std::string& topic, dds::TopicDataTyp
   listener_->counter = counter_;
   dds::DataWriterQos wq = dds::DATAWRITER_QOS_DEFAULT;
   apply(qos, wq);
+  // Reliable writers announce what they have every 200 ms (Fast DDS: 3 s), so a
+  // sample lost on the wire is repaired within a fraction of a second: a lost
+  // gesture event or sync tick must not wait seconds. Measured in tests/integration/lan.sh.
+  wq.reliable_writer_qos().times.heartbeatPeriod = eprosima::fastrtps::Duration_t(0, 200000000);
   writer_ = ctx.publisher().create_datawriter(&t, wq, listener_.get(), dds::StatusMask::publication_matched());
   if (writer_ == nullptr) {
     throw std::runtime_error("component '" + ctx.name() + "': could not create a writer on " + topic);

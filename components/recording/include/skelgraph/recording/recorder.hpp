@@ -40,7 +40,8 @@ class Recorder final : public runtime::Component {
   void on_sample(const runtime::TopicInfo& topic, bool keyed, const msg::RawSample& s, const runtime::SampleMeta& m);
   void open(const std::string& label, std::uint32_t session_id);
   void close();
-  void stop_session();  // close after the linger period
+  void stop_session(std::chrono::milliseconds wait);  // close after `wait` (a sooner call shortens it)
+  static constexpr std::chrono::milliseconds kSessionStopGrace{3000};
   void fail(const std::string& what);
 
   RecorderOptions options_;
@@ -52,6 +53,7 @@ class Recorder final : public runtime::Component {
   std::chrono::milliseconds linger_{0};
   runtime::TimerHandle linger_timer_;
   bool linger_timer_active_ = false;
+  std::chrono::milliseconds linger_wait_{0};
   std::unique_ptr<SessionRecorder> session_;
   std::vector<Latched> latched_;
   std::vector<std::string> topics_;

@@ -13,14 +13,27 @@ struct DdsConfig {
   int domain = 0;
   // UDP interfaces to use (lan); empty keeps what the profile says.
   std::vector<std::string> interfaces;
+  // Discovery servers ("IP:PORT", the i-th being server id i, as `fastdds
+  // discovery -i i` starts it): when set, the participant is their client
+  // (no multicast discovery). Profiles that are clients need at least one.
+  std::vector<std::string> discovery_servers;
   // Reported in status messages and sync acks.
   std::string host;
 
   // Defaults from the environment: SKELGRAPH_PROFILE, SKELGRAPH_DOMAIN,
-  // SKELGRAPH_INTERFACES (comma-separated), SKELGRAPH_HOST (else the host name).
+  // SKELGRAPH_INTERFACES (comma-separated), SKELGRAPH_DISCOVERY_SERVERS
+  // (comma-separated IP:PORT), SKELGRAPH_HOST (else the host name).
   // Throws std::runtime_error on a malformed value.
   static DdsConfig from_env();
 };
+
+// An "IP:PORT" discovery server address (IPv4 dotted quad, port 1..65535).
+// Throws std::runtime_error saying what is wrong.
+struct ServerAddress {
+  std::string ip;
+  int port = 0;
+};
+ServerAddress parse_server_address(const std::string& text);
 
 // Directory holding the profile XML files: $SKELGRAPH_PROFILES_DIR, else the
 // source tree's bringup/profiles (the build-tree program), else ./bringup/profiles.

@@ -1,0 +1,151 @@
+#!/usr/bin/env bash
+# A cell on three hosts of a LAN (network namespaces, tests/integration/netns_cell.sh),
+# each running its part of bringup/cell.yaml on the `lan` profile bound to its
+# interface: discovery across hosts; fused output at full rate from both sensor
+# hosts; a session recorded on every host and merged by tick; and faults:
+# sensor1's cable pulled for 5 s (everything resumes without restarts, the
+# reliable sync ticks all arrive), 10 % loss and 20 ms delay on it (reliable
+# topics lose nothing, best-effort skeletons degrade gracefully), sensor2's
+# host process killed and restarted (fusion degrades and recovers).
+#
+#   lan.sh SKELGRAPH LOSSY_LINK
+source "$(dirname "$0")/lib.sh"
+LOSSY=${2:?usage: $0 skelgraph lossy_link}
+source "$(dirname "$0")/netns_cell.sh"
+if ! netns_available; then
+  echo "SKIP: this kernel or user may not create network namespaces (ip netns add failed): the LAN tests need them"
+  exit 77
+fi
+cell_up "$LOSSY"
+
+start_host() {  # start_host HOST: its part of the cell, in the background; pid in HOST_PID
+  spawn_sg "$1" "$WORK/$1.json" "$WORK/$1.err" launch "$SRC/bringup/cell.yaml" --host "$1" --duration 170 --json
+  HOST_PID=$SPAWNED
+}
+start_host sensor1; p_sensor1=$HOST_PID
+start_host sensor2; p_sensor2=$HOST_PID
+start_host fusion; p_fusion=$HOST_PID
+
+# Every component's status as the fusion host sees it, logged for the whole test.
+status_log() {
+  spawn_sg fusion "$WORK/status.jsonl" "$WORK/status.err" topic echo skelgraph/status --json
+}
+# seen SECONDS WANT [COND]: waits (bounded) until statuses logged from now on include every
+# "host/component" in WANT (space-separated) and the python COND over `s` (the latest status
+# by "host/component") holds; those statuses are left in $WORK/status.json.
+seen() {
+  local deadline=$((SECONDS + $1)) from
+  from=$(wc -l <"$WORK/status.jsonl")
+  while [ "$SECONDS" -lt "$deadline" ]; do
+    python3 -c '
+import json, sys
+s = {}
+for n, line in enumerate(open(sys.argv[1])):
+    if n < int(sys.argv[2]) or not line.endswith("\n"):
+        continue
+    d = json.loads(line)["data"]
+    s[d["host"] + "/" + d["component_name"]] = d
+json.dump(s, open(sys.argv[5], "w"))
+sys.exit(0 if all(w in s for w in sys.argv[3].split()) and eval(sys.argv[4]) else 1)' \
+      "$WORK/status.jsonl" "$from" "$2" "${3:-True}" "$WORK/status.json" && return 0
+    sleep 0.3
+  done
+  return 1
+}
+fusion_state() {  # fusion_state STATE [SECONDS]: the fusion component reports STATE
+  seen "${2:-30}" "fusion/fusion" 's["fusion/fusion"]["state"] == "'"$1"'"'
+}
+rate() {  # rate NAME: the fused rate over 3 s, seen on the fusion host
+  sg fusion topic hz skelgraph/skeleton/fused --window 3 --json --timeout 10 >"$WORK/hz_$1.json" 2>/dev/null &&
+    json_get "$WORK/hz_$1.json" 'round(d["rate_hz"], 1)'
+}
+in_range() { python3 -c "import sys; sys.exit(0 if $2 <= float(sys.argv[1]) <= $3 else 1)" "$1"; }
+
+status_log
+
+# 1. Discovery across hosts and the fused output.
+seen 30 "sensor1/sensor1 sensor1/recorder sensor2/sensor2 sensor2/recorder fusion/sync fusion/fusion fusion/gesture fusion/recorder" ||
+  fail "not every host's components seen from the fusion host: $(cat "$WORK/status.json"); $(tail -3 "$WORK"/*.err)"
+fusion_state OK || fail "fusion never OK: $(tail -3 "$WORK/fusion.err")"
+sg fusion topic echo skelgraph/skeleton/fused --json --count 30 --timeout 5 >"$WORK/fused.jsonl"
+python3 -c '
+import json, sys
+masks = [max(j["sensor_mask"] for j in json.loads(l)["data"]["joints"]) for l in open(sys.argv[1])]
+sys.exit(0 if max(masks) == 3 else 1)' "$WORK/fused.jsonl" || fail "fused joints do not come from both sensor hosts"
+r=$(rate up)
+in_range "$r" 27 33 || fail "fused rate across hosts: $r Hz"
+ok "three hosts discovered each other (lan profile, multicast on their bridge); fused $r Hz from both sensor hosts"
+# A session of our own from here on (the launch's own one began before the hosts had met).
+sg fusion sync start --label lan --timeout 10 >/dev/null || fail "sync start"
+
+# 2. sensor1's cable pulled for 5 s (less than the 10 s lease: the hosts keep each other):
+# fusion degrades, then everything resumes without restarts.
+link down
+cut=$SECONDS
+fusion_state DEGRADED 4 || fail "fusion did not notice sensor1 gone within 4 s"
+json_check "$WORK/status.json" '"sensor1" in d["fusion/fusion"]["message"]'
+sleep $((cut + 5 - SECONDS)) 2>/dev/null || true
+link up
+fusion_state OK 30 || fail "fusion did not take sensor1 back after the cable returned"
+r=$(rate after_cut)
+in_range "$r" 27 33 || fail "fused rate after the cut: $r Hz"
+ok "cable pulled for 5 s: fusion DEGRADED (sensor1 silent), OK again once it returned, $r Hz"
+
+# 3. 10 % loss and 20 ms delay each way on sensor1's cable.
+sleep 1
+link loss 0.1
+link delay 20
+sleep 2
+sg fusion topic hz skelgraph/sensor/frame --window 6 --json --timeout 10 >"$WORK/frames_lossy.json"
+r=$(rate lossy)
+link loss 0
+link delay 0
+# Two sensors at 30 Hz, a tenth of sensor1's frames lost: about 57 frames/s arrive.
+json_check "$WORK/frames_lossy.json" '40 < d["rate_hz"] < 61'
+in_range "$r" 25 33 || fail "fused rate with a lossy cable: $r Hz"
+ok "10 % loss + 20 ms delay on sensor1's cable: sensor frames $(json_get "$WORK/frames_lossy.json" 'round(d["rate_hz"], 1)')/s at the fusion host, fused $r Hz"
+
+# 4. The session, recorded on every host through all of that, merged by tick: every tick acked by every host.
+sg fusion sync stop --timeout 10 --json >"$WORK/stop.json" || fail "sync stop"
+sleep 1
+files=$(ls "$WORK"/{fusion,sensor1,sensor2}/recordings/lan_*.mcap 2>/dev/null | wc -l)
+[ "$files" -eq 3 ] || fail "expected a recording per host: $(ls -R "$WORK"/*/recordings)"
+"$SKELGRAPH" bag merge "$WORK"/{fusion,sensor1,sensor2}/recordings/lan_*.mcap --out "$WORK/merged.mcap" --json >"$WORK/merge.json" ||
+  fail "merge"
+"$SKELGRAPH" bag info "$WORK/merged.mcap" --json >"$WORK/info.json"
+python3 - "$WORK/info.json" "$(json_get "$WORK/stop.json" 'd["tick"]')" <<'PY' || fail "merged recording: $(head -c 600 "$WORK/info.json")"
+import json, sys
+info = json.load(open(sys.argv[1]))
+acks = info["ticks_acked_by_host"]
+ticks = int(sys.argv[2])  # the last tick of the session (STOP)
+assert set(acks) == {"fusion", "sensor1", "sensor2"}, acks
+assert ticks > 300, ticks
+assert all(n == ticks for n in acks.values()), (acks, ticks)   # the cut and the lossy cable lost no tick
+print(f"{ticks} ticks, acked by {acks}")
+PY
+for h in fusion sensor1 sensor2; do "$SKELGRAPH" bag info "$WORK/$h"/recordings/lan_*.mcap --json >"$WORK/info_$h.json"; done
+python3 - "$WORK" <<'PY' || fail "gesture events differ between the hosts' recordings"
+import json, sys
+count = lambda h: {t["topic"]: t["count"] for t in json.load(open(f"{sys.argv[1]}/info_{h}.json"))["topics"]}.get("skelgraph/gesture/event", 0)
+n = {h: count(h) for h in ("fusion", "sensor1", "sensor2")}
+print("gesture events recorded per host:", n)
+assert n["fusion"] > 0 and n["sensor1"] == n["fusion"] == n["sensor2"], n   # reliable: sensor1 lost none on its bad cable
+PY
+ok "session merged from three hosts: every one of $(json_get "$WORK/stop.json" 'd["tick"]') ticks acked by every host, sensor1's through the cut and the loss"
+
+# 5. sensor2's host process killed and started again.
+kill -KILL "$p_sensor2"
+wait "$p_sensor2" 2>/dev/null || true
+fusion_state DEGRADED 20 || fail "fusion did not notice sensor2 gone"
+json_check "$WORK/status.json" '"sensor2" in d["fusion/fusion"]["message"]'
+start_host sensor2; p_sensor2=$HOST_PID
+fusion_state OK 30 || fail "fusion did not take sensor2 back"
+# The fused output stalls for up to ~0.6 s while the new process joins (seen on 2 cores); the rate after that:
+sleep 2
+r=$(rate back)
+in_range "$r" 27 33 || fail "fused rate after sensor2 came back: $r Hz"
+ok "sensor2's host process killed: fusion DEGRADED; restarted: OK at $r Hz"
+
+kill -INT "$p_fusion" "$p_sensor1" "$p_sensor2"
+for p in "$p_fusion" "$p_sensor1" "$p_sensor2"; do wait "$p" || fail "a host did not stop cleanly: $(tail -3 "$WORK"/*.err)"; done
+echo "lan: all checks passed"
