@@ -1,22 +1,34 @@
 #!/usr/bin/env bash
 # A cell on three hosts of a LAN (network namespaces, tests/integration/netns_cell.sh),
-# each running its part of bringup/cell.yaml on the `lan` profile bound to its
-# interface: discovery across hosts; fused output at full rate from both sensor
+# each running its part of bringup/cell.yaml bound to its interface, on the
+# `lan` profile (multicast discovery) or `lan-discovery-server` (a Fast DDS
+# discovery server on the fusion host, no multicast at all: counted on the
+# wire): discovery across hosts; fused output at full rate from both sensor
 # hosts; a session recorded on every host and merged by tick; and faults:
 # sensor1's cable pulled for 5 s (everything resumes without restarts, the
 # reliable sync ticks all arrive), 10 % loss and 20 ms delay on it (reliable
 # topics lose nothing, best-effort skeletons degrade gracefully), sensor2's
 # host process killed and restarted (fusion degrades and recovers).
 #
-#   lan.sh SKELGRAPH LOSSY_LINK
+#   lan.sh SKELGRAPH LOSSY_LINK multicast|discovery-server
 source "$(dirname "$0")/lib.sh"
-LOSSY=${2:?usage: $0 skelgraph lossy_link}
+LOSSY=${2:?usage: $0 skelgraph lossy_link multicast|discovery-server}
+MODE=${3:?usage: $0 skelgraph lossy_link multicast|discovery-server}
+case $MODE in
+  multicast) CELL_PROFILE=lan ;;
+  discovery-server) CELL_PROFILE=lan-discovery-server ;;
+  *) fail "mode: multicast or discovery-server, not $MODE" ;;
+esac
 source "$(dirname "$0")/netns_cell.sh"
 if ! netns_available; then
   echo "SKIP: this kernel or user may not create network namespaces (ip netns add failed): the LAN tests need them"
   exit 77
 fi
 cell_up "$LOSSY"
+if [ "$MODE" = discovery-server ]; then
+  CELL_DDS_ARGS=(--discovery-server "$(addr fusion):11811")
+  spawn fusion "$WORK/server.out" "$WORK/server.err" fastdds discovery -i 0 -l "$(addr fusion)" -p 11811
+fi
 
 start_host() {  # start_host HOST: its part of the cell, in the background; pid in HOST_PID
   spawn_sg "$1" "$WORK/$1.json" "$WORK/$1.err" launch "$SRC/bringup/cell.yaml" --host "$1" --duration 170 --json
@@ -74,7 +86,15 @@ masks = [max(j["sensor_mask"] for j in json.loads(l)["data"]["joints"]) for l in
 sys.exit(0 if max(masks) == 3 else 1)' "$WORK/fused.jsonl" || fail "fused joints do not come from both sensor hosts"
 r=$(rate up)
 in_range "$r" 27 33 || fail "fused rate across hosts: $r Hz"
-ok "three hosts discovered each other (lan profile, multicast on their bridge); fused $r Hz from both sensor hosts"
+link_stats "$WORK/link_up.json"
+if [ "$MODE" = multicast ]; then
+  json_check "$WORK/link_up.json" 'd["a_to_b"]["rtps_multicast"] > 0'
+  how="multicast discovery: $(json_get "$WORK/link_up.json" 'd["a_to_b"]["rtps_multicast"]') RTPS multicast frames from sensor1"
+else
+  json_check "$WORK/link_up.json" 'd["a_to_b"]["rtps_multicast"] == 0 and d["b_to_a"]["rtps_multicast"] == 0'
+  how="discovery server, no RTPS multicast on sensor1's cable in $(json_get "$WORK/link_up.json" 'd["a_to_b"]["frames"] + d["b_to_a"]["frames"]') frames"
+fi
+ok "three hosts discovered each other ($CELL_PROFILE: $how); fused $r Hz from both sensor hosts"
 # A session of our own from here on (the launch's own one began before the hosts had met).
 sg fusion sync start --label lan --timeout 10 >/dev/null || fail "sync start"
 

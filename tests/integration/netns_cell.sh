@@ -11,7 +11,9 @@
 #   on HOST CMD...           run CMD in HOST (cwd $WORK/HOST, its own /dev/shm)
 #   sg HOST ARGS...          skelgraph ARGS in HOST on the cell's profile ($CELL_PROFILE, default lan)
 #   spawn_sg HOST OUT ERR ARGS...   the same in the background, pid in SPAWNED
+#   spawn HOST OUT ERR CMD...       any command in HOST in the background, pid in SPAWNED
 #   link CMD                 a command to sensor1's cable
+#   link_stats FILE          its frame counts so far (JSON; see tests/support/lossy_link.cpp)
 #   addr HOST                the host's address
 
 NS=sg$$_
@@ -73,6 +75,12 @@ on() {
   ip netns exec "$NS$h" unshare -m bash -c 'mount --bind "$0" /dev/shm && cd "$1" && shift && exec "$@"' \
     "$WORK/shm_$h" "$WORK/$h" "$@"
 }
+spawn() {
+  local h=$1 out=$2 err=$3; shift 3
+  ( exec ip netns exec "$NS$h" unshare -m bash -c 'mount --bind "$0" /dev/shm && cd "$1" && shift && exec "$@"' \
+      "$WORK/shm_$h" "$WORK/$h" "$@" >"$out" 2>>"$err" ) &
+  SPAWNED=$!
+}
 sg_args() { echo --profile "$CELL_PROFILE" --interface "$(addr "$1")" "${CELL_DDS_ARGS[@]}"; }
 sg() {
   local h=$1; shift
@@ -82,12 +90,8 @@ sg() {
 # process (its pid in SPAWNED: killing it kills skelgraph), stdout/stderr to OUT/ERR.
 spawn_sg() {
   local h=$1 out=$2 err=$3; shift 3
-  local args
-  args=$(sg_args "$h")
-  # shellcheck disable=SC2086
-  ( exec ip netns exec "$NS$h" unshare -m bash -c 'mount --bind "$0" /dev/shm && cd "$1" && shift && exec "$@"' \
-      "$WORK/shm_$h" "$WORK/$h" "$SKELGRAPH" "$@" $args >"$out" 2>>"$err" ) &
-  SPAWNED=$!
+  # shellcheck disable=SC2046
+  spawn "$h" "$out" "$err" "$SKELGRAPH" "$@" $(sg_args "$h")
 }
 
 link() {
@@ -99,4 +103,18 @@ link() {
     python3 -c 'import time; time.sleep(0.02)'
   done
   fail "lossy_link did not take '$*': $(tail -2 "$WORK/link.out")"
+}
+
+link_stats() {
+  local before
+  before=$(grep -c "^{" "$WORK/link.out" || true)
+  echo stats >&7
+  for _ in $(seq 50); do
+    if [ "$(grep -c "^{" "$WORK/link.out" || true)" -gt "$before" ]; then
+      grep "^{" "$WORK/link.out" | tail -1 >"$1"
+      return 0
+    fi
+    python3 -c 'import time; time.sleep(0.02)'
+  done
+  fail "lossy_link gave no stats"
 }

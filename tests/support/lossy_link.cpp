@@ -8,8 +8,10 @@
 // creates TAP IF_A in /run/netns/NS_A and IF_B in /run/netns/NS_B (not yet
 // up or addressed: the caller configures them), prints "ready", and relays
 // until SIGINT/SIGTERM. Commands on stdin, one per line, apply to both
-// directions: "loss P" (0..1), "delay MS", "down", "up". Each is answered
-// with "ok ..." on stdout. Counts go to stdout at exit as JSON.
+// directions: "loss P" (0..1), "delay MS", "down", "up", and "stats" (the
+// counts so far as one JSON line: frames, dropped, delivered, and
+// rtps_multicast: IPv4 frames to 239.255.0.0/16, DDS's multicast groups). Each
+// is answered on stdout ("ok ..." or the JSON). The counts are printed at exit too.
 
 #include <fcntl.h>
 #include <linux/if.h>
@@ -60,8 +62,23 @@ struct Frame {
 struct Direction {
   int from, to;
   std::deque<Frame> queue;  // constant delay: due times in order
-  unsigned long long frames = 0, dropped = 0, delivered = 0;
+  unsigned long long frames = 0, dropped = 0, delivered = 0, rtps_multicast = 0;
 };
+
+// An Ethernet frame carrying IPv4 to 239.255.x.x (RTPS multicast: discovery of the default profiles).
+bool rtps_multicast(const unsigned char* f, std::size_t n) {
+  return n >= 34 && f[12] == 0x08 && f[13] == 0x00 && f[30] == 239 && f[31] == 255;
+}
+
+std::string stats_json(const Direction (&d)[2]) {
+  char out[512];
+  std::snprintf(out, sizeof(out),
+                "{\"a_to_b\": {\"frames\": %llu, \"dropped\": %llu, \"delivered\": %llu, \"rtps_multicast\": %llu}, "
+                "\"b_to_a\": {\"frames\": %llu, \"dropped\": %llu, \"delivered\": %llu, \"rtps_multicast\": %llu}}",
+                d[0].frames, d[0].dropped, d[0].delivered, d[0].rtps_multicast, d[1].frames, d[1].dropped,
+                d[1].delivered, d[1].rtps_multicast);
+  return out;
+}
 
 }  // namespace
 
@@ -113,6 +130,7 @@ int main(int argc, char** argv) {
         const ssize_t n = read(d[k].from, buf.data(), buf.size());
         if (n <= 0) break;
         ++d[k].frames;
+        if (rtps_multicast(buf.data(), static_cast<std::size_t>(n))) ++d[k].rtps_multicast;
         if (!up || uniform(rng) < loss) {
           ++d[k].dropped;
           continue;
@@ -141,8 +159,12 @@ int main(int argc, char** argv) {
           delay = std::chrono::microseconds(static_cast<long long>(v * 1000.0));
         } else if (cmd == "down" || cmd == "up") {
           up = cmd == "up";
+        } else if (cmd == "stats") {
+          std::printf("%s\n", stats_json(d).c_str());
+          std::fflush(stdout);
+          continue;
         } else if (!cmd.empty()) {
-          std::printf("error: unknown command '%s' (loss P | delay MS | down | up)\n", cmd.c_str());
+          std::printf("error: unknown command '%s' (loss P | delay MS | down | up | stats)\n", cmd.c_str());
           std::fflush(stdout);
           continue;
         }
@@ -161,8 +183,6 @@ int main(int argc, char** argv) {
       }
     }
   }
-  std::printf("{\"a_to_b\": {\"frames\": %llu, \"dropped\": %llu, \"delivered\": %llu}, "
-              "\"b_to_a\": {\"frames\": %llu, \"dropped\": %llu, \"delivered\": %llu}}\n",
-              d[0].frames, d[0].dropped, d[0].delivered, d[1].frames, d[1].dropped, d[1].delivered);
+  std::printf("%s\n", stats_json(d).c_str());
   return 0;
 }

@@ -51,7 +51,10 @@ TopicPlan plan_for(const std::string& topic, ToolSession& s, Ms timeout) {
   if (const auto* t = runtime::find_topic(topic)) {
     const auto* m = msg::find_message(t->type_name);
     TopicPlan p{t->type_name, m != nullptr && m->keyed, t->qos};
-    if (p.qos.depth == 0) p.qos.depth = 1000;  // a tool keeps up or drops, never blocks writers
+    // A tool keeps up or drops, never blocks writers (keep-all becomes 1000);
+    // and it shows every sample it can: samples arriving together (the status of
+    // every component of a process) must not overwrite each other in a queue of 1.
+    p.qos.depth = p.qos.depth == 0 ? 1000 : std::max(p.qos.depth, 100);
     return p;
   }
   runtime::EndpointInfo w;
