@@ -25,6 +25,10 @@ if ! netns_available; then
   exit 77
 fi
 cell_up "$LOSSY"
+# Everything on the switch, captured from before the hosts start (tshark).
+spawn sw "$WORK/tshark.out" "$WORK/tshark.err" tshark -i br0 -w "$WORK/cell.pcapng" -q
+capture=$SPAWNED
+wait_for_match "$WORK/tshark.err" "Capturing on" 10 || fail "tshark did not start: $(cat "$WORK/tshark.err")"
 if [ "$MODE" = discovery-server ]; then
   CELL_DDS_ARGS=(--discovery-server "$(addr fusion):11811")
   spawn fusion "$WORK/server.out" "$WORK/server.err" fastdds discovery -i 0 -l "$(addr fusion)" -p 11811
@@ -95,6 +99,19 @@ else
   how="discovery server, no RTPS multicast on sensor1's cable in $(json_get "$WORK/link_up.json" 'd["a_to_b"]["frames"] + d["b_to_a"]["frames"]') frames"
 fi
 ok "three hosts discovered each other ($CELL_PROFILE: $how); fused $r Hz from both sensor hosts"
+
+# What a user's tshark sees on the wire: our topics and types in the discovery data, and user data.
+kill -INT "$capture"
+wait "$capture" || true
+tshark -r "$WORK/cell.pcapng" -Y rtps -T fields -E separator=';' -e rtps.param.topicName -e rtps.param.typeName \
+  2>/dev/null | tr ',;' '\n\n' | sort -u >"$WORK/sedp.txt"
+for want in skelgraph/skeleton/raw skelgraph/skeleton/fused skelgraph/sync skelgraph/sync_ack skelgraph/gesture/event \
+  skelgraph/calibration skelgraph::msg::Skeleton skelgraph::msg::SyncCommand skelgraph::msg::GestureEvent; do
+  grep -qx "$want" "$WORK/sedp.txt" || fail "tshark saw no $want in the discovery data: $(tr '\n' ' ' <"$WORK/sedp.txt")"
+done
+data=$(tshark -r "$WORK/cell.pcapng" -Y "rtps.sm.id == 0x15" 2>/dev/null | wc -l)  # DATA submessages
+[ "$data" -gt 100 ] || fail "tshark decoded only $data RTPS DATA packets"
+ok "tshark on the switch: $(grep -c / "$WORK/sedp.txt") topics and $(grep -c :: "$WORK/sedp.txt") types named in discovery, $data DATA packets"
 # A session of our own from here on (the launch's own one began before the hosts had met).
 sg fusion sync start --label lan --timeout 10 >/dev/null || fail "sync start"
 

@@ -49,6 +49,7 @@ cell_up() {
   ip -n "${NS}sw" link set lo up
   ip -n "${NS}sw" link add br0 type bridge
   ip -n "${NS}sw" link set br0 up
+  mkdir -p "$WORK/sw" "$WORK/shm_sw"
   for h in fusion sensor1 sensor2; do
     ip netns add "$NS$h"
     ip -n "$NS$h" link set lo up
