@@ -58,7 +58,7 @@ Context::Context(std::string name, const DdsConfig& config, dds::DomainParticipa
     throw std::runtime_error("DDS profile file " + file + " has no participant profile named '" + profile + "'");
   }
   qos.name(name_);
-  apply_type_policy(qos);
+  announce_type_information_ = apply_type_policy(qos);
   if (!config.interfaces.empty()) {
     bool any_udp = false;
     for (auto& t : qos.transport().user_transports) {
@@ -157,6 +157,7 @@ dds::Topic& Context::topic(const std::string& name, dds::TopicDataType* support)
   }
   const auto registered = participant_->find_type(type.get_type_name());
   if (registered.empty()) {
+    if (!announce_type_information_) withhold_type_information(*support);
     if (participant_->register_type(type) != ReturnCode_t::RETCODE_OK) {
       throw std::runtime_error("component '" + name_ + "': could not register type " + type.get_type_name());
     }

@@ -96,6 +96,8 @@ class Context {
   eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
   eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;
   std::map<std::string, eprosima::fastdds::dds::Topic*> topics_;
+  // The profile's "skelgraph.type_information" property (type_policy.hpp).
+  bool announce_type_information_ = true;
   mutable std::mutex mutex_;
   std::vector<std::shared_ptr<EndpointCounter>> counters_;
   std::vector<eprosima::fastdds::dds::DataWriter*> reliable_writers_;

@@ -15,6 +15,14 @@ void register_type_objects();
 // Sets what `support` announces; applied to every generated type (make_type_support).
 void apply_type_policy(eprosima::fastdds::dds::TopicDataType& support);
 // Participant side: answers TypeLookup requests so tools can fetch our types.
-void apply_type_policy(eprosima::fastdds::dds::DomainParticipantQos& qos);
+// Returns whether the participant's types announce their TypeInformation: yes,
+// unless the profile says otherwise with the participant property
+// `skelgraph.type_information` = `off` (the *-interop profiles: Cyclone DDS
+// 0.10 rejects Fast DDS 2.9's TypeInformation, so it cannot match endpoints
+// that announce it; see docs/interop.md). Throws std::runtime_error for a
+// value other than on/off.
+bool apply_type_policy(eprosima::fastdds::dds::DomainParticipantQos& qos);
+// For a participant that announces no type information (see above).
+void withhold_type_information(eprosima::fastdds::dds::TopicDataType& support);
 
 }  // namespace skelgraph::runtime
