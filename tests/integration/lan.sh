@@ -111,6 +111,9 @@ for want in skelgraph/skeleton/raw skelgraph/skeleton/fused skelgraph/sync skelg
 done
 data=$(tshark -r "$WORK/cell.pcapng" -Y "rtps.sm.id == 0x15" 2>/dev/null | wc -l)  # DATA submessages
 [ "$data" -gt 100 ] || fail "tshark decoded only $data RTPS DATA packets"
+# Without security everything is readable: skeleton frame ids ("world") in the clear (secure.sh: none).
+world=$(python3 -c 'import sys; print(open(sys.argv[1], "rb").read().count(b"world"))' "$WORK/cell.pcapng")
+[ "$world" -gt 100 ] || fail "only $world plaintext 'world' frame ids in an unencrypted capture"
 ok "tshark on the switch: $(grep -c / "$WORK/sedp.txt") topics and $(grep -c :: "$WORK/sedp.txt") types named in discovery, $data DATA packets"
 # A session of our own from here on (the launch's own one began before the hosts had met).
 sg fusion sync start --label lan --timeout 10 >/dev/null || fail "sync start"

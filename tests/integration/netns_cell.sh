@@ -8,7 +8,7 @@
 # Namespaces are named after this script's pid and removed on exit.
 #
 #   cell_up LOSSY_LINK       make the namespaces
-#   on HOST CMD...           run CMD in HOST (cwd $WORK/HOST, its own /dev/shm)
+#   on HOST CMD...           run CMD in HOST (cwd $WORK/HOST, its own /dev/shm, SKELGRAPH_HOST=HOST unless set)
 #   sg HOST ARGS...          skelgraph ARGS in HOST on the cell's profile ($CELL_PROFILE, default lan)
 #   spawn_sg HOST OUT ERR ARGS...   the same in the background, pid in SPAWNED
 #   spawn HOST OUT ERR CMD...       any command in HOST in the background, pid in SPAWNED
@@ -73,12 +73,12 @@ cell_up() {
 
 on() {
   local h=$1; shift
-  ip netns exec "$NS$h" unshare -m bash -c 'mount --bind "$0" /dev/shm && cd "$1" && shift && exec "$@"' \
+  SKELGRAPH_HOST="${SKELGRAPH_HOST:-$h}" ip netns exec "$NS$h" unshare -m bash -c 'mount --bind "$0" /dev/shm && cd "$1" && shift && exec "$@"' \
     "$WORK/shm_$h" "$WORK/$h" "$@"
 }
 spawn() {
   local h=$1 out=$2 err=$3; shift 3
-  ( exec ip netns exec "$NS$h" unshare -m bash -c 'mount --bind "$0" /dev/shm && cd "$1" && shift && exec "$@"' \
+  ( SKELGRAPH_HOST="${SKELGRAPH_HOST:-$h}" exec ip netns exec "$NS$h" unshare -m bash -c 'mount --bind "$0" /dev/shm && cd "$1" && shift && exec "$@"' \
       "$WORK/shm_$h" "$WORK/$h" "$@" >"$out" 2>>"$err" ) &
   SPAWNED=$!
 }

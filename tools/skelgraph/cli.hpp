@@ -25,6 +25,7 @@ struct GlobalOptions {
   std::optional<std::string> profile;
   std::vector<std::string> interfaces;
   std::vector<std::string> discovery_servers;
+  std::optional<std::string> security_dir;
   std::string log_level = "info";
 };
 
@@ -51,6 +52,7 @@ void add_play_data_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_topic_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_sync_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_player_command(CLI::App& app, GlobalOptions& g, Action& run);
+void add_security_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_demo_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_components_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_sim_command(CLI::App& app, GlobalOptions& g, Action& run);

@@ -25,6 +25,7 @@ runtime::DdsConfig make_config(const GlobalOptions& g, const runtime::LaunchSpec
   if (g.domain) c.domain = *g.domain;
   if (g.profile) c.profile = *g.profile;
   if (!g.interfaces.empty()) c.interfaces = g.interfaces;
+  if (g.security_dir) c.security_dir = *g.security_dir;
   if (!g.discovery_servers.empty()) {
     for (const auto& a : g.discovery_servers) runtime::parse_server_address(a);
     c.discovery_servers = g.discovery_servers;
@@ -62,6 +63,8 @@ void add_dds_options(CLI::App& cmd, GlobalOptions& g) {
   cmd.add_option("--discovery-server", g.discovery_servers,
                  "discover through this server, IP:PORT (repeatable: the i-th is `fastdds discovery -i i`; "
                  "lan-discovery-server profile; env SKELGRAPH_DISCOVERY_SERVERS)");
+  cmd.add_option("--security", g.security_dir,
+                 "DDS Security credentials from `skelgraph security init` (secure profile; env SKELGRAPH_SECURITY_DIR)");
 }
 
 void block_signals() {
@@ -115,6 +118,7 @@ int main(int argc, char** argv) {
   add_topic_command(app, g, run);
   add_sync_command(app, g, run);
   add_player_command(app, g, run);
+  add_security_command(app, g, run);
   add_demo_command(app, g, run);
   add_components_command(app, g, run);
   add_sim_command(app, g, run);

@@ -4,7 +4,10 @@
 #include <cstdlib>
 #include <algorithm>
 #include <chrono>
+#include <filesystem>
 #include <set>
+#include <utility>
+#include <vector>
 #include <stdexcept>
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
@@ -16,6 +19,7 @@
 #include <fastdds/dds/topic/Topic.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
 #include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
+#include <fastdds/rtps/attributes/PropertyPolicy.h>
 #include <fastdds/rtps/attributes/ServerAttributes.h>
 #include <fastrtps/utils/IPLocator.h>
 
@@ -38,6 +42,44 @@ void load_profile_file(const std::string& file) {
     throw std::runtime_error("DDS profile file " + file + " could not be loaded (see the Fast DDS error above)");
   }
   loaded.insert(file);
+}
+
+// DDS Security from `skelgraph security init` credentials (see DdsConfig::security_dir).
+// Returns whether security is on. Paths go to Fast DDS as file:// + absolute path.
+bool apply_security(dds::DomainParticipantQos& qos, const DdsConfig& config, const std::string& profile) {
+  const std::string* required =
+      eprosima::fastrtps::rtps::PropertyPolicyHelper::find_property(qos.properties(), "skelgraph.security");
+  const bool must = required != nullptr && *required == "required";
+  if (config.security_dir.empty()) {
+    if (must) {
+      throw std::runtime_error("DDS profile '" + profile +
+                               "' needs security credentials: --security DIR or SKELGRAPH_SECURITY_DIR (make them "
+                               "with `skelgraph security init DIR --master HOST --sensors HOST,...`)");
+    }
+    return false;
+  }
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::absolute(config.security_dir);
+  const auto need = [&](const fs::path& f) {
+    if (!fs::is_regular_file(f)) {
+      throw std::runtime_error("security: no " + f.string() + " (credentials for host '" + config.host +
+                               "' are made by `skelgraph security init " + dir.string() + " ...` with that host)");
+    }
+    return "file://" + f.lexically_normal().string();
+  };
+  const std::vector<std::pair<std::string, std::string>> props = {
+      {"dds.sec.auth.plugin", "builtin.PKI-DH"},
+      {"dds.sec.auth.builtin.PKI-DH.identity_ca", need(dir / "ca.pem")},
+      {"dds.sec.auth.builtin.PKI-DH.identity_certificate", need(dir / "hosts" / (config.host + ".pem"))},
+      {"dds.sec.auth.builtin.PKI-DH.private_key", need(dir / "hosts" / (config.host + ".key"))},
+      {"dds.sec.access.plugin", "builtin.Access-Permissions"},
+      {"dds.sec.access.builtin.Access-Permissions.permissions_ca", need(dir / "ca.pem")},
+      {"dds.sec.access.builtin.Access-Permissions.governance", need(dir / "governance.p7s")},
+      {"dds.sec.access.builtin.Access-Permissions.permissions", need(dir / "permissions.p7s")},
+      {"dds.sec.crypto.plugin", "builtin.AES-GCM-GMAC"},
+  };
+  for (const auto& [k, v] : props) qos.properties().properties().emplace_back(k, v);
+  return true;
 }
 
 }  // namespace
@@ -91,11 +133,17 @@ Context::Context(std::string name, const DdsConfig& config, dds::DomainParticipa
                              "' discovers through a discovery server: name it with --discovery-server IP:PORT or "
                              "SKELGRAPH_DISCOVERY_SERVERS (start one with `fastdds discovery -i 0 -l IP -p PORT`)");
   }
+  const bool secure = apply_security(qos, config, profile);
   participant_ = factory->create_participant(static_cast<dds::DomainId_t>(config.domain), qos, listener,
                                              dds::StatusMask::none());
   if (participant_ == nullptr) {
-    throw std::runtime_error("component '" + name_ + "': could not create a DDS participant on domain " +
-                             std::to_string(config.domain) + " with profile '" + profile + "' (" + file + ")");
+    throw std::runtime_error(
+        "component '" + name_ + "': could not create a DDS participant on domain " + std::to_string(config.domain) +
+        " with profile '" + profile + "' (" + file + ")" +
+        (secure ? "; with security on, the usual causes are credentials of another cell, a certificate not signed "
+                  "by ca.pem, or governance/permissions not signed by it: check with `skelgraph security check " +
+                      config.security_dir + " --host " + config.host + "`"
+                : ""));
   }
 }
 

@@ -49,6 +49,7 @@ DdsConfig DdsConfig::from_env() {
       }
     }
   }
+  if (const char* d = env("SKELGRAPH_SECURITY_DIR")) c.security_dir = d;
   if (const char* h = env("SKELGRAPH_HOST")) {
     c.host = h;
   } else {

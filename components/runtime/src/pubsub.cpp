@@ -66,7 +66,11 @@ WriterBase::WriterBase(Context& ctx, const std::string& topic, dds::TopicDataTyp
   wq.reliable_writer_qos().times.heartbeatPeriod = eprosima::fastrtps::Duration_t(0, 200000000);
   writer_ = ctx.publisher().create_datawriter(&t, wq, listener_.get(), dds::StatusMask::publication_matched());
   if (writer_ == nullptr) {
-    throw std::runtime_error("component '" + ctx.name() + "': could not create a writer on " + topic);
+    throw std::runtime_error("component '" + ctx.name() + "': could not create a writer on " + topic +
+                             (ctx.config().security_dir.empty()
+                                  ? std::string()
+                                  : " (security: the permissions do not let host '" + ctx.config().host +
+                                        "' publish it; see permissions.xml in " + ctx.config().security_dir + ")"));
   }
   if (qos.reliability == Reliability::Reliable) ctx.track_reliable_writer(writer_);
 }
@@ -171,7 +175,11 @@ ReaderBase::ReaderBase(Context& ctx, const std::string& topic, dds::TopicDataTyp
        << dds::StatusMask::sample_rejected();
   state_->reader = state_->subscriber->create_datareader(&t, rq, state_.get(), mask);
   if (state_->reader == nullptr) {
-    throw std::runtime_error("component '" + ctx.name() + "': could not create a reader on " + topic);
+    throw std::runtime_error("component '" + ctx.name() + "': could not create a reader on " + topic +
+                             (ctx.config().security_dir.empty()
+                                  ? std::string()
+                                  : " (security: the permissions do not let host '" + ctx.config().host +
+                                        "' subscribe to it; see permissions.xml in " + ctx.config().security_dir + ")"));
   }
 }
 

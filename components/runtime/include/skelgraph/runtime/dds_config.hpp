@@ -17,12 +17,18 @@ struct DdsConfig {
   // discovery -i i` starts it): when set, the participant is their client
   // (no multicast discovery). Profiles that are clients need at least one.
   std::vector<std::string> discovery_servers;
-  // Reported in status messages and sync acks.
+  // DDS Security credentials made by `skelgraph security init` (ca.pem,
+  // governance.p7s, permissions.p7s, hosts/<host>.pem and .key): when set, the
+  // participant authenticates as `host` and encrypts as the governance says.
+  // The `secure` profile requires it.
+  std::string security_dir;
+  // Reported in status messages and sync acks; the identity under security.
   std::string host;
 
   // Defaults from the environment: SKELGRAPH_PROFILE, SKELGRAPH_DOMAIN,
   // SKELGRAPH_INTERFACES (comma-separated), SKELGRAPH_DISCOVERY_SERVERS
-  // (comma-separated IP:PORT), SKELGRAPH_HOST (else the host name).
+  // (comma-separated IP:PORT), SKELGRAPH_SECURITY_DIR, SKELGRAPH_HOST (else
+  // the host name).
   // Throws std::runtime_error on a malformed value.
   static DdsConfig from_env();
 };

@@ -1,0 +1,99 @@
+#!/usr/bin/env bash
+# The secure profile on three hosts (network namespaces, netns_cell.sh):
+# credentials from `skelgraph security init` (a master, two sensor hosts, a
+# read-only host), the cell working end to end; strangers shut out: no
+# credentials, or a certificate of another CA, can neither read skeletons nor
+# start a recording; the read-only host reads fused skeletons but cannot
+# publish sync commands; on the wire (tshark) no topic name, type name or
+# other plaintext of our data.
+#
+#   secure.sh SKELGRAPH LOSSY_LINK
+source "$(dirname "$0")/lib.sh"
+LOSSY=${2:?usage: $0 skelgraph lossy_link}
+CELL_PROFILE=secure
+source "$(dirname "$0")/netns_cell.sh"
+if ! netns_available; then
+  echo "SKIP: this kernel or user may not create network namespaces (ip netns add failed): the LAN tests need them"
+  exit 77
+fi
+cell_up "$LOSSY"
+"$SKELGRAPH" security init "$WORK/creds" --master fusion --sensors sensor1,sensor2 --readers robot --json >"$WORK/init.json"
+json_check "$WORK/init.json" 'd["hosts"]["robot"]["role"] == "reader" and "*" in d["hosts"]["fusion"]["publishes"]'
+"$SKELGRAPH" security check "$WORK/creds" --json >"$WORK/check.json" || fail "security check: $(cat "$WORK/check.json")"
+"$SKELGRAPH" security init "$WORK/other" --master fusion --sensors sensor1,sensor2 >/dev/null  # another cell's CA
+CELL_DDS_ARGS=(--security "$WORK/creds")
+
+spawn sw "$WORK/tshark.out" "$WORK/tshark.err" tshark -i br0 -w "$WORK/cell.pcapng" -q
+capture=$SPAWNED
+wait_for_match "$WORK/tshark.err" "Capturing on" 10 || fail "tshark did not start: $(cat "$WORK/tshark.err")"
+for h in sensor1 sensor2 fusion; do
+  spawn_sg "$h" "$WORK/$h.json" "$WORK/$h.err" launch "$SRC/bringup/cell.yaml" --host "$h" --duration 120 --json
+  eval "p_$h=\$SPAWNED"
+done
+
+# 1. The cell, authenticated and encrypted, end to end.
+rate() { sg fusion topic hz skelgraph/skeleton/fused --window 3 --json --timeout 15 >"$WORK/hz_$1.json" 2>"$WORK/hz_$1.err" &&
+  json_get "$WORK/hz_$1.json" 'round(d["rate_hz"], 1)'; }
+r=$(rate secure) || fail "no fused skeletons on the secure cell: $(tail -3 "$WORK"/*.err)"
+python3 -c "import sys; sys.exit(0 if 27 <= float(sys.argv[1]) <= 33 else 1)" "$r" || fail "fused rate: $r Hz"
+sg fusion topic echo skelgraph/skeleton/fused --json --count 20 --timeout 5 >"$WORK/fused.jsonl"
+python3 -c '
+import json, sys
+masks = [max(j["sensor_mask"] for j in json.loads(l)["data"]["joints"]) for l in open(sys.argv[1])]
+sys.exit(0 if max(masks) == 3 else 1)' "$WORK/fused.jsonl" || fail "fused joints not from both sensor hosts"
+sg fusion sync start --label secure --timeout 10 >/dev/null || fail "sync start on the secure cell"
+ok "secure cell: fused $r Hz from both authenticated sensor hosts; sync session started by the master host"
+
+# 2. Strangers on sensor2's host try to read and to start a recording (their own sync master).
+stranger() {  # stranger NAME ARGS...: read fused skeletons, then act as sync master for 4 s
+  local name=$1; shift
+  if on sensor2 "$SKELGRAPH" topic echo skelgraph/skeleton/fused --count 1 --timeout 5 "$@" >"$WORK/$name.read" 2>&1; then
+    fail "$name read fused skeletons: $(head -c 300 "$WORK/$name.read")"
+  fi
+  on sensor2 "$SKELGRAPH" launch "$SRC/bringup/sync.yaml" --duration 4 "$@" >"$WORK/$name.sync" 2>&1 || true
+}
+stranger nocreds --profile lan --interface "$(addr sensor2)"
+stranger otherca --profile secure --security "$WORK/other" --interface "$(addr sensor2)"
+grep -q "no sample on skelgraph/skeleton/fused" "$WORK/nocreds.read" || fail "nocreds: $(cat "$WORK/nocreds.read")"
+# The read-only host: reads, but may not publish sync commands.
+SKELGRAPH_HOST=robot on sensor2 "$SKELGRAPH" topic echo skelgraph/skeleton/fused --count 5 --json --timeout 10 \
+  $(sg_args sensor2) >"$WORK/robot.read" 2>"$WORK/robot.err" || fail "the read-only host could not read: $(cat "$WORK/robot.err")"
+if SKELGRAPH_HOST=robot on sensor2 "$SKELGRAPH" launch "$SRC/bringup/sync.yaml" --duration 3 $(sg_args sensor2) \
+  >"$WORK/robot.sync" 2>&1; then
+  fail "the read-only host ran a sync master: $(tail -3 "$WORK/robot.sync")"
+fi
+grep -q "could not create a writer on skelgraph/sync (security: the permissions do not let host 'robot' publish it" \
+  "$WORK/robot.sync" || fail "robot's refusal: $(tail -3 "$WORK/robot.sync")"
+sg fusion sync stop --timeout 10 --json >"$WORK/stop.json" || fail "sync stop"
+sleep 1
+# Every recorder recorded the master's session only: no session of the strangers'.
+ls "$WORK"/{fusion,sensor1,sensor2}/recordings/ >"$WORK/files.txt"
+grep -q "^secure_" "$WORK/files.txt" || fail "no secure session recorded: $(cat "$WORK/files.txt")"
+if grep -q "^session_" "$WORK/files.txt"; then fail "a recorder obeyed a stranger's START: $(cat "$WORK/files.txt")"; fi
+"$SKELGRAPH" bag merge "$WORK"/{fusion,sensor1,sensor2}/recordings/secure_*.mcap --out "$WORK/merged.mcap" >/dev/null
+"$SKELGRAPH" bag info "$WORK/merged.mcap" --json >"$WORK/info.json"
+json_check "$WORK/info.json" 'all(d["ticks_acked_by_host"].get(h) == '"$(json_get "$WORK/stop.json" 'd["tick"]')"' for h in ("fusion", "sensor1", "sensor2"))'
+ok "no credentials / another CA: read nothing, started no recording; read-only host reads but its sync master is refused"
+
+# 3. The wire: encrypted. No topic or type name (discovery and status data name them in the clear on lan).
+kill -INT "$capture"
+wait "$capture" || true
+frames=$(tshark -r "$WORK/cell.pcapng" 2>/dev/null | wc -l)
+[ "$frames" -gt 1000 ] || fail "capture too small: $frames frames"
+secure=$(tshark -r "$WORK/cell.pcapng" -Y "rtps.sm.id == 0x31 || rtps.sm.id == 0x33" 2>/dev/null | wc -l)  # SEC_PREFIX, SRTPS_PREFIX
+[ "$secure" -gt 100 ] || fail "only $secure packets with protected RTPS submessages"
+topics=$(tshark -r "$WORK/cell.pcapng" -Y rtps.param.topicName -T fields -e rtps.param.topicName 2>/dev/null | grep -c . || true)
+[ "$topics" -eq 0 ] || fail "$topics topic names in clear discovery data"
+# In the clear by design of DDS Security: certificates (host names) and the signed permissions
+# document (its <topic> rules) in the authentication handshake, participant names in SPDP.
+# Not: topic names anywhere else (discovery, status data), type names, frame ids of skeletons ("world").
+plain=$(python3 -c '
+import re, sys
+data = open(sys.argv[1], "rb").read()
+print(len(re.findall(rb"(?<!<topic>)skelgraph/", data)) + data.count(b"skelgraph::msg") + data.count(b"world"))' "$WORK/cell.pcapng")
+[ "$plain" -eq 0 ] || fail "$plain plaintext topic names, type names or skeleton frame ids in the capture"
+ok "tshark: $frames frames, $secure with protected RTPS submessages, no topic/type name or skeleton data in the clear"
+
+for h in fusion sensor1 sensor2; do eval "kill -INT \$p_$h"; done
+for h in fusion sensor1 sensor2; do eval "wait \$p_$h" || fail "$h did not stop cleanly: $(tail -3 "$WORK/$h.err")"; done
+echo "secure: all checks passed"
