@@ -20,7 +20,7 @@ unshare -n bash -c '
   set -e
   ip link set lo up
   export SKELGRAPH_DOMAIN=78
-  "$1/bench/depth_receive" $(( $2 + 4 )) >"$3/recv.json" & r=$!
+  "$1/bench/stream_receive" $(( $2 + 4 )) depth >"$3/recv.json" & r=$!
   "$1/bench/publish_streams" 0 2 "$2" >"$3/pub.json"
   wait $r
 ' _ "$build" "$seconds" "$work"
@@ -41,7 +41,8 @@ def rows(path):
                         "tracker_fps_one_thread": 1000.0 / s["depth"]["track_ms_per_frame"] if s["depth"]["track_ms_per_frame"] else None})
     return out
 print(json.dumps({
-    "transport": {"published": pub["depth"], "frame_bytes": pub["depth_frame_bytes"], "streams": recv,
+    "transport": {"published": pub["depth"], "frame_bytes": pub["depth_frame_bytes"], "streams": recv["streams"],
+                  "cpu_s": {"publisher": pub["cpu_s"], "receiver": recv["cpu_s"]},
                   "profile": "loopback (SHM 64 MiB segment, UDP 127.0.0.1 with 4 MiB buffers)"},
     "tracker": {"size": "320x240", "one_sensor": rows(w + "/one.json"), "two_sensors": rows(w + "/two.json"),
                 "two_sensors_merged_clouds": rows(w + "/merged.json"),

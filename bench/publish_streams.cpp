@@ -1,6 +1,8 @@
 // Load generator for the recording benchmark: N skeleton streams and M depth
 // streams (640x480 uint16) at 30 Hz for a given time, after waiting for a
 // reader on each topic. Prints what it published as JSON.
+#include <sys/resource.h>
+
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -66,8 +68,11 @@ int main(int argc, char** argv) {
   // until the reader has taken them: stay a moment so the last frames are not
   // destroyed in flight (a real source keeps running).
   std::this_thread::sleep_for(std::chrono::seconds(1));
+  rusage ru{};
+  getrusage(RUSAGE_SELF, &ru);
+  const double cpu = ru.ru_utime.tv_sec + ru.ru_utime.tv_usec * 1e-6 + ru.ru_stime.tv_sec + ru.ru_stime.tv_usec * 1e-6;
   std::printf("%s\n", nlohmann::json{{"skeleton_raw", n_skel}, {"depth", n_depth}, {"failed", failed},
-                                     {"seconds", elapsed}, {"depth_frame_bytes", mm.size() * 2}}
+                                     {"seconds", elapsed}, {"depth_frame_bytes", mm.size() * 2}, {"cpu_s", cpu}}
                           .dump()
                           .c_str());
   return 0;
