@@ -36,21 +36,29 @@ static void check(dds_return_t rc, const char* what) {
   }
 }
 
+/* A participant and the sync topic (reliable, keep-all QoS in *rel; the caller deletes it). */
+static dds_entity_t sync_topic(dds_entity_t* pp, dds_qos_t** rel) {
+  *pp = dds_create_participant(domain(), NULL, NULL);
+  check(*pp, "participant");
+  dds_entity_t t = dds_create_topic(*pp, &skelgraph_msg_SyncCommand_desc, "skelgraph/sync", NULL, NULL);
+  check(t, "topic skelgraph/sync");
+  *rel = dds_create_qos();
+  dds_qset_reliability(*rel, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+  dds_qset_history(*rel, DDS_HISTORY_KEEP_ALL, 0);
+  return t;
+}
+
 static int sub(double seconds) {
-  dds_entity_t pp = dds_create_participant(domain(), NULL, NULL);
-  check(pp, "participant");
+  dds_entity_t pp;
+  dds_qos_t* rel;
+  dds_entity_t t_sync = sync_topic(&pp, &rel);
   dds_entity_t t_skel = dds_create_topic(pp, &skelgraph_msg_Skeleton_desc, "skelgraph/skeleton/raw", NULL, NULL);
   check(t_skel, "topic skelgraph/skeleton/raw");
-  dds_entity_t t_sync = dds_create_topic(pp, &skelgraph_msg_SyncCommand_desc, "skelgraph/sync", NULL, NULL);
-  check(t_sync, "topic skelgraph/sync");
   dds_qos_t* be = dds_create_qos();
   dds_qset_reliability(be, DDS_RELIABILITY_BEST_EFFORT, 0);
   dds_qset_history(be, DDS_HISTORY_KEEP_LAST, 100);
   dds_entity_t r_skel = dds_create_reader(pp, t_skel, be, NULL);
   check(r_skel, "reader skeleton");
-  dds_qos_t* rel = dds_create_qos();
-  dds_qset_reliability(rel, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
-  dds_qset_history(rel, DDS_HISTORY_KEEP_ALL, 0);
   dds_entity_t r_sync = dds_create_reader(pp, t_sync, rel, NULL);
   check(r_sync, "reader sync");
 
@@ -98,13 +106,9 @@ static int sub(double seconds) {
 }
 
 static int sync_master(const char* label, unsigned session) {
-  dds_entity_t pp = dds_create_participant(domain(), NULL, NULL);
-  check(pp, "participant");
-  dds_entity_t t_sync = dds_create_topic(pp, &skelgraph_msg_SyncCommand_desc, "skelgraph/sync", NULL, NULL);
-  check(t_sync, "topic skelgraph/sync");
-  dds_qos_t* rel = dds_create_qos();
-  dds_qset_reliability(rel, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
-  dds_qset_history(rel, DDS_HISTORY_KEEP_ALL, 0);
+  dds_entity_t pp;
+  dds_qos_t* rel;
+  dds_entity_t t_sync = sync_topic(&pp, &rel);
   dds_entity_t w = dds_create_writer(pp, t_sync, rel, NULL);
   check(w, "writer sync");
   /* Wait (at most 10 s) for a reader: our recorder. */
