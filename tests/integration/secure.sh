@@ -26,22 +26,28 @@ CELL_DDS_ARGS=(--security "$WORK/creds")
 spawn sw "$WORK/tshark.out" "$WORK/tshark.err" tshark -i br0 -w "$WORK/cell.pcapng" -q
 capture=$SPAWNED
 wait_for_match "$WORK/tshark.err" "Capturing on" 10 || fail "tshark did not start: $(cat "$WORK/tshark.err")"
-for h in sensor1 sensor2 fusion; do
+# Hosts one after another (a second apart): participants that discover each other at
+# the same moment sometimes never finish authenticating with Fast DDS 2.9 (docs/security.md).
+for h in fusion sensor1 sensor2; do
   spawn_sg "$h" "$WORK/$h.json" "$WORK/$h.err" launch "$SRC/bringup/cell.yaml" --host "$h" --duration 120 --json
   eval "p_$h=\$SPAWNED"
+  sleep 1
 done
 
+# A new secure participant (each command-line tool run is one) sometimes does not
+# match the cell within 30 s, and the next one does within 1-2 s (Fast DDS 2.9's
+# authentication; measured and reported in docs/security.md): tools here get 3 tries.
 # 1. The cell, authenticated and encrypted, end to end.
 rate() { sg fusion topic hz skelgraph/skeleton/fused --window 3 --json --timeout 15 >"$WORK/hz_$1.json" 2>"$WORK/hz_$1.err" &&
   json_get "$WORK/hz_$1.json" 'round(d["rate_hz"], 1)'; }
-r=$(rate secure) || fail "no fused skeletons on the secure cell: $(tail -3 "$WORK"/*.err)"
+r=$(retry 3 rate secure) || fail "no fused skeletons on the secure cell: $(tail -3 "$WORK"/*.err)"
 python3 -c "import sys; sys.exit(0 if 27 <= float(sys.argv[1]) <= 33 else 1)" "$r" || fail "fused rate: $r Hz"
-sg fusion topic echo skelgraph/skeleton/fused --json --count 20 --timeout 5 >"$WORK/fused.jsonl"
+retry 3 sg fusion topic echo skelgraph/skeleton/fused --json --count 20 --timeout 10 >"$WORK/fused.jsonl"
 python3 -c '
 import json, sys
 masks = [max(j["sensor_mask"] for j in json.loads(l)["data"]["joints"]) for l in open(sys.argv[1])]
 sys.exit(0 if max(masks) == 3 else 1)' "$WORK/fused.jsonl" || fail "fused joints not from both sensor hosts"
-sg fusion sync start --label secure --timeout 10 >/dev/null || fail "sync start on the secure cell"
+retry 3 sg fusion sync start --label secure --timeout 10 >/dev/null || fail "sync start on the secure cell"
 ok "secure cell: fused $r Hz from both authenticated sensor hosts; sync session started by the master host"
 
 # 2. Strangers on sensor2's host try to read and to start a recording (their own sync master).
@@ -56,7 +62,7 @@ stranger nocreds --profile lan --interface "$(addr sensor2)"
 stranger otherca --profile secure --security "$WORK/other" --interface "$(addr sensor2)"
 grep -q "no sample on skelgraph/skeleton/fused" "$WORK/nocreds.read" || fail "nocreds: $(cat "$WORK/nocreds.read")"
 # The read-only host: reads, but may not publish sync commands.
-SKELGRAPH_HOST=robot on sensor2 "$SKELGRAPH" topic echo skelgraph/skeleton/fused --count 5 --json --timeout 10 \
+SKELGRAPH_HOST=robot retry 3 on sensor2 "$SKELGRAPH" topic echo skelgraph/skeleton/fused --count 5 --json --timeout 10 \
   $(sg_args sensor2) >"$WORK/robot.read" 2>"$WORK/robot.err" || fail "the read-only host could not read: $(cat "$WORK/robot.err")"
 if SKELGRAPH_HOST=robot on sensor2 "$SKELGRAPH" launch "$SRC/bringup/sync.yaml" --duration 3 $(sg_args sensor2) \
   >"$WORK/robot.sync" 2>&1; then
@@ -64,7 +70,7 @@ if SKELGRAPH_HOST=robot on sensor2 "$SKELGRAPH" launch "$SRC/bringup/sync.yaml" 
 fi
 grep -q "could not create a writer on skelgraph/sync (security: the permissions do not let host 'robot' publish it" \
   "$WORK/robot.sync" || fail "robot's refusal: $(tail -3 "$WORK/robot.sync")"
-sg fusion sync stop --timeout 10 --json >"$WORK/stop.json" || fail "sync stop"
+retry 3 sg fusion sync stop --timeout 10 --json >"$WORK/stop.json" || fail "sync stop"
 sleep 1
 # Every recorder recorded the master's session only: no session of the strangers'.
 ls "$WORK"/{fusion,sensor1,sensor2}/recordings/ >"$WORK/files.txt"
