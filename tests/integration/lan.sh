@@ -76,6 +76,17 @@ rate() {  # rate NAME: the fused rate over 3 s, seen on the fusion host
     json_get "$WORK/hz_$1.json" 'round(d["rate_hz"], 1)'
 }
 in_range() { python3 -c "import sys; sys.exit(0 if $2 <= float(sys.argv[1]) <= $3 else 1)" "$1"; }
+# steady_rate NAME LO HI: the fused rate in [LO, HI] Hz in one of up to three 3 s windows
+# (the steady state: a host starting up, e.g. the gesture component training its
+# classifier, can hold the fusion host's 2 cores for a moment); prints the last rate.
+steady_rate() {
+  local r=0
+  for _ in 1 2 3; do
+    r=$(rate "$1") && in_range "$r" "$2" "$3" && { echo "$r"; return 0; }
+  done
+  echo "$r"
+  return 1
+}
 
 status_log
 
@@ -88,8 +99,7 @@ python3 -c '
 import json, sys
 masks = [max(j["sensor_mask"] for j in json.loads(l)["data"]["joints"]) for l in open(sys.argv[1])]
 sys.exit(0 if max(masks) == 3 else 1)' "$WORK/fused.jsonl" || fail "fused joints do not come from both sensor hosts"
-r=$(rate up)
-in_range "$r" 27 33 || fail "fused rate across hosts: $r Hz"
+r=$(steady_rate up 27 33) || fail "fused rate across hosts: $r Hz"
 link_stats "$WORK/link_up.json"
 if [ "$MODE" = multicast ]; then
   json_check "$WORK/link_up.json" 'd["a_to_b"]["rtps_multicast"] > 0'
@@ -127,8 +137,7 @@ json_check "$WORK/status.json" '"sensor1" in d["fusion/fusion"]["message"]'
 sleep $((cut + 5 - SECONDS)) 2>/dev/null || true
 link up
 fusion_state OK 30 || fail "fusion did not take sensor1 back after the cable returned"
-r=$(rate after_cut)
-in_range "$r" 27 33 || fail "fused rate after the cut: $r Hz"
+r=$(steady_rate after_cut 27 33) || fail "fused rate after the cut: $r Hz"
 ok "cable pulled for 5 s: fusion DEGRADED (sensor1 silent), OK again once it returned, $r Hz"
 
 # 3. 10 % loss and 20 ms delay each way on sensor1's cable.
@@ -137,12 +146,11 @@ link loss 0.1
 link delay 20
 sleep 2
 sg fusion topic hz skelgraph/sensor/frame --window 6 --json --timeout 10 >"$WORK/frames_lossy.json"
-r=$(rate lossy)
+r=$(steady_rate lossy 25 33) || fail "fused rate with a lossy cable: $r Hz"
 link loss 0
 link delay 0
 # Two sensors at 30 Hz, a tenth of sensor1's frames lost: about 57 frames/s arrive.
 json_check "$WORK/frames_lossy.json" '40 < d["rate_hz"] < 61'
-in_range "$r" 25 33 || fail "fused rate with a lossy cable: $r Hz"
 ok "10 % loss + 20 ms delay on sensor1's cable: sensor frames $(json_get "$WORK/frames_lossy.json" 'round(d["rate_hz"], 1)')/s at the fusion host, fused $r Hz"
 
 # 4. The session, recorded on every host through all of that, merged by tick: every tick acked by every host.
@@ -182,8 +190,7 @@ start_host sensor2; p_sensor2=$HOST_PID
 fusion_state OK 30 || fail "fusion did not take sensor2 back"
 # The fused output stalls for up to ~0.6 s while the new process joins (seen on 2 cores); the rate after that:
 sleep 2
-r=$(rate back)
-in_range "$r" 27 33 || fail "fused rate after sensor2 came back: $r Hz"
+r=$(steady_rate back 27 33) || fail "fused rate after sensor2 came back: $r Hz"
 ok "sensor2's host process killed: fusion DEGRADED; restarted: OK at $r Hz"
 
 kill -INT "$p_fusion" "$p_sensor1" "$p_sensor2"
