@@ -1,0 +1,149 @@
+#include "skelgraph/viewer/viewer_component.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include "skelgraph/msg/json.hpp"
+#include "skelgraph/runtime/topics.hpp"
+#include "skelgraph/skeleton/skeleton_msg.hpp"
+#include "skelgraph/viewer/client_command.hpp"
+
+#ifndef SKELGRAPH_VIEWER_WEB_DIR
+#define SKELGRAPH_VIEWER_WEB_DIR ""
+#endif
+
+namespace skelgraph::viewer {
+
+runtime::ComponentInfo ViewerComponent::describe() {
+  runtime::ComponentInfo info{"viewer", "Live 3-D view of the cell in a web browser (HTTP + WebSocket)", {}};
+  info.params.add_string("address", "127.0.0.1", "address to serve the page on (0.0.0.0: every interface)")
+      .add_int("port", 8080, "TCP port (0: any free port, printed at start)", 0, 65535)
+      .add_double("rate_hz", 30.0, "frames sent to each page per second", 1.0, 120.0)
+      .add_int("max_clients", 64, "pages connected at once; more are refused (HTTP 503)", 1, 4096)
+      .add_double("max_age_s", 0.5, "a skeleton not updated for this long is no longer drawn", 0.05, 60.0)
+      .add_double("fov_h_deg", 57.0, "sensors' horizontal field of view (drawn frustums)", 1.0, 179.0)
+      .add_double("fov_v_deg", 43.0, "sensors' vertical field of view", 1.0, 179.0)
+      .add_double("far_m", 4.0, "depth of the drawn frustums", 0.1, 50.0)
+      .add_string("web_root", "", "folder with the page (default: the one the build made)");
+  return info;
+}
+
+namespace {
+SceneOptions scene_options(const runtime::Params& p) {
+  SceneOptions o;
+  o.max_age_ns = static_cast<std::int64_t>(p.get<double>("max_age_s") * 1e9);
+  o.fov_h_deg = p.get<double>("fov_h_deg");
+  o.fov_v_deg = p.get<double>("fov_v_deg");
+  o.far_m = p.get<double>("far_m");
+  return o;
+}
+std::int64_t now() { return runtime::Context::monotonic_ns(); }
+}  // namespace
+
+ViewerComponent::ViewerComponent(runtime::Context& ctx, const runtime::Params& params)
+    : Component(ctx),
+      scene_(scene_options(params)),
+      address_(params.get<std::string>("address")),
+      period_ns_(static_cast<std::int64_t>(1e9 / params.get<double>("rate_hz"))),
+      play_pub_(ctx, runtime::topics::kPlayControl),
+      raw_sub_(ctx, runtime::topics::kSkeletonRaw, [this](const msg::Skeleton& m, const runtime::SampleMeta&) { on_skeleton(m, now()); }),
+      fused_sub_(ctx, runtime::topics::kSkeletonFused, [this](const msg::Skeleton& m, const runtime::SampleMeta&) { on_skeleton(m, now()); }),
+      truth_sub_(ctx, runtime::topics::kSkeletonTruth, [this](const msg::Skeleton& m, const runtime::SampleMeta&) { on_skeleton(m, now()); }),
+      pose_sub_(ctx, runtime::topics::kCalibration,
+                [this](const msg::SensorPose& m, const runtime::SampleMeta&) {
+                  if (!scene_.on_pose(skeleton::from_msg(m)))
+                    spdlog::warn("{}: pose of {} is in frame '{}', not 'world': not drawn", ctx_.name(),
+                                 m.sensor_id().to_string(), m.frame_id().to_string());
+                }),
+      gesture_sub_(ctx, runtime::topics::kGestureEvent,
+                   [this](const msg::GestureEvent& e, const runtime::SampleMeta&) { scene_.on_gesture(e, now()); }),
+      status_sub_(ctx, runtime::topics::kStatus,
+                  [this](const msg::ComponentStatus& s, const runtime::SampleMeta&) {
+                    scene_.on_status(s.component_name().to_string(), s, now());
+                  }),
+      play_state_sub_(ctx, runtime::topics::kPlayState,
+                      [this](const msg::PlayState& s, const runtime::SampleMeta&) { scene_.on_player(s.player().to_string(), s); }) {
+  std::string root = params.get<std::string>("web_root");
+  if (root.empty()) root = SKELGRAPH_VIEWER_WEB_DIR;
+  Server::Options o;
+  o.address = address_;
+  o.port = static_cast<std::uint16_t>(params.get<std::int64_t>("port"));
+  o.max_clients = static_cast<std::size_t>(params.get<std::int64_t>("max_clients"));
+  o.assets = load_assets(root);
+  server_ = std::make_unique<Server>(std::move(o), [this](const std::string& text, bool& bad) {
+    return on_client_message(text, bad);
+  });
+}
+
+ViewerComponent::~ViewerComponent() { on_shutdown(); }
+
+std::string ViewerComponent::url() const {
+  return "http://" + address_ + ":" + std::to_string(server_->port()) + "/";
+}
+
+void ViewerComponent::on_start() {
+  spdlog::info("{}: open {} in a browser", ctx_.name(), url());
+  timer_ = ctx_.executor().every(std::chrono::nanoseconds(period_ns_), [this] {
+    const auto t = now();
+    auto frame = scene_.frame(t);
+    frame["viewer"] = ctx_.name();
+    frame["made_ns"] = t;  // CLOCK_MONOTONIC of this host: delays measured by clients on it
+    server_->broadcast(std::make_shared<const std::string>(frame.dump()));
+    ++frames_made_;
+  });
+}
+
+void ViewerComponent::on_shutdown() { timer_.cancel(); }
+
+void ViewerComponent::on_skeleton(const msg::Skeleton& m, std::int64_t now_ns) {
+  scene_.on_skeleton(skeleton::from_msg(m), now_ns);
+}
+
+// On the server's thread: only the (thread-safe) PlayControl writer is touched here.
+std::string ViewerComponent::on_client_message(const std::string& text, bool& bad) {
+  const auto parsed = parse_client_message(text);
+  if (!parsed.ok) {
+    bad = true;
+    return nlohmann::json{{"type", "error"}, {"message", parsed.error}}.dump();
+  }
+  const auto& c = parsed.command;
+  if (c.type == ClientCommand::Type::Ping) return nlohmann::json{{"type", "pong"}, {"id", c.ping_id}}.dump();
+  msg::PlayControl pc;
+  pc.target(c.target);
+  pc.kind(c.play_kind == "pause"    ? msg::PLAY_PAUSE
+          : c.play_kind == "resume" ? msg::PLAY_RESUME
+          : c.play_kind == "step"   ? msg::PLAY_STEP
+                                    : msg::PLAY_SPEED);
+  pc.value(c.value);
+  const auto id = ctx_.name() + "-" + std::to_string(++play_requests_);
+  pc.request_id(id);
+  const bool sent = play_pub_.publish(pc);
+  return nlohmann::json{{"type", "play"}, {"request_id", id}, {"sent", sent}}.dump();
+}
+
+std::string ViewerComponent::summary() const {
+  const auto s = server_->stats();
+  return url() + ": " + std::to_string(s.connections) + " page(s) connected (peak " + std::to_string(s.peak_clients) +
+         " at once), " + std::to_string(frames_made_.load()) + " frames made, " + std::to_string(s.frames_dropped) +
+         " dropped for slow pages, " + std::to_string(s.bad_messages) + " bad client messages, " +
+         std::to_string(s.refused) + " refused";
+}
+
+nlohmann::json ViewerComponent::details() const {
+  const auto s = server_->stats();
+  return {{"url", url()},
+          {"port", server_->port()},
+          {"frames_made", frames_made_.load()},
+          {"clients", s.clients},
+          {"peak_clients", s.peak_clients},
+          {"connections", s.connections},
+          {"refused", s.refused},
+          {"messages_sent", s.messages_sent},
+          {"frames_dropped", s.frames_dropped},
+          {"bad_messages", s.bad_messages},
+          {"http_requests", s.http_requests},
+          {"play_requests", play_requests_.load()}};
+}
+
+}  // namespace skelgraph::viewer
+
+SKELGRAPH_REGISTER_COMPONENT(viewer, skelgraph::viewer::ViewerComponent)

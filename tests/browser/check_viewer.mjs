@@ -1,0 +1,85 @@
+// Opens the viewer page in Debian's Chromium (headless, WebGL in software) with
+// Playwright and reports, as JSON, what the page drew: snapshots of its drawn
+// skeletons (stream, person, frame number, joints), its frame rate, and what
+// the layer toggle, pause and a malformed request did. Saves a screenshot.
+//   node check_viewer.mjs URL SCREENSHOT.png [SECONDS]
+import { chromium } from 'playwright-core';
+
+const [url, screenshot, secondsArg] = process.argv.slice(2);
+if (!url || !screenshot) {
+  console.error('usage: node check_viewer.mjs URL SCREENSHOT.png [SECONDS]');
+  process.exit(2);
+}
+const seconds = Number(secondsArg || 5);
+const executablePath = process.env.CHROMIUM || '/usr/bin/chromium';
+const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+
+const browser = await chromium.launch({
+  executablePath,
+  headless: true,
+  // Root in a container: no sandbox. WebGL without a GPU: SwiftShader.
+  args: ['--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist'],
+});
+const out = { console_errors: [], page_errors: [] };
+try {
+  const page = await browser.newPage({ viewport: { width: 1280, height: 800 } });
+  page.on('console', (m) => { if (m.type() === 'error') out.console_errors.push(m.text()); });
+  page.on('pageerror', (e) => out.page_errors.push(String(e)));
+  await page.goto(url);
+  await page.waitForFunction(() => window.skelgraphViewer && window.skelgraphViewer.framesDrawn > 10, null,
+                             { timeout: 30000 });
+  const stats = () => page.evaluate(() => JSON.parse(JSON.stringify(window.skelgraphViewer)));
+
+  // Frame rate: frames received and drawn over SECONDS.
+  const a = await stats();
+  const t0 = Date.now();
+  const snapshots = [];
+  while (Date.now() - t0 < seconds * 1000) {
+    await sleep(250);
+    snapshots.push((await stats()).drawn);
+  }
+  const b = await stats();
+  const dt = (Date.now() - t0) / 1000;
+  out.received_per_s = (b.framesReceived - a.framesReceived) / dt;
+  out.drawn_per_s = (b.framesDrawn - a.framesDrawn) / dt;
+  out.page_fps = b.fps;
+  out.sensors = b.sensors;
+  out.snapshots = snapshots;
+
+  // Layer toggle: hide the first sensor's skeleton.
+  const before = (await stats()).drawn;
+  const hidden = before.list.find((s) => s.kind === 'raw');
+  if (hidden) {
+    await page.uncheck(`input[data-layer="${hidden.stream}"]`);
+    await sleep(300);
+    const after = (await stats()).drawn;
+    out.toggle = { stream: hidden.stream, before: before.skeletons,
+                   after: after.skeletons, still_drawn: after.list.some((s) => s.stream === hidden.stream) };
+    await page.check(`input[data-layer="${hidden.stream}"]`);
+    await sleep(300);
+    out.toggle.restored = (await stats()).drawn.list.some((s) => s.stream === hidden.stream);
+  }
+
+  // Pause freezes the view while frames keep arriving.
+  await page.click('#pause');
+  const p0 = await stats();
+  await sleep(1000);
+  const p1 = await stats();
+  await page.click('#pause');
+  await sleep(500);
+  const p2 = await stats();
+  out.pause = { drawn_while_paused: p1.framesDrawn - p0.framesDrawn, received_while_paused: p1.framesReceived - p0.framesReceived,
+                drawn_after_resume: p2.framesDrawn - p1.framesDrawn };
+
+  // A malformed request is answered with an error; the stream goes on.
+  await page.evaluate(() => window.skelgraphSend('{"cmd":"rewind"}'));
+  await sleep(500);
+  const e = await stats();
+  out.malformed = { errors: e.errors, still_receiving: e.framesReceived > p2.framesReceived, connected: e.connected };
+
+  await page.screenshot({ path: screenshot });
+  out.screenshot = screenshot;
+} finally {
+  await browser.close();
+}
+console.log(JSON.stringify(out));

@@ -1,0 +1,119 @@
+#!/usr/bin/env bash
+# The browser viewer end to end (issue 10): bringup/sim_dual_viewer.yaml (two
+# simulated sensors, fusion, viewer) on loopback; Debian's Chromium, driven by
+# Playwright, opens the page; what the page drew is checked against what was
+# published; then 20 WebSocket clients read for 30 s beside a stalled, a
+# malformed and a reconnecting one, and fusion must keep its rate.
+#   viewer.sh SKELGRAPH BROWSER_DIR WS_LOAD   (BROWSER_DIR: tests/browser installed by npm)
+# The page's screenshot: $SKELGRAPH_VIEWER_SCREENSHOT, default build/viewer-screenshot.png.
+source "$(dirname "$0")/lib.sh"
+BROWSER_DIR=${2:?browser folder}
+WS_LOAD=${3:?ws_load}
+CHROMIUM=${CHROMIUM:-/usr/bin/chromium}
+[ -x "$CHROMIUM" ] || fail "no Chromium at $CHROMIUM (Debian package chromium; tools/run test installs it)"
+[ -f "$BROWSER_DIR/node_modules/playwright-core/package.json" ] || fail "playwright-core is not installed in $BROWSER_DIR (ctest fixture browser_install)"
+SHOT=${SKELGRAPH_VIEWER_SCREENSHOT:-$(cd "$(dirname "$SKELGRAPH")/.." && pwd)/viewer-screenshot.png}
+PORT=8080
+URL="http://127.0.0.1:$PORT/"
+
+# What is published, to compare with what the page draws.
+for t in raw fused truth; do
+  "$SKELGRAPH" topic echo "skelgraph/skeleton/$t" --json >"$WORK/$t.jsonl" 2>/dev/null &
+done
+"$SKELGRAPH" launch bringup/sim_dual_viewer.yaml --json >"$WORK/launch.json" 2>"$WORK/launch.err" &
+launch=$!
+wait_for_match "$WORK/launch.err" "open $URL" 20 || { cat "$WORK/launch.err" >&2; fail "the viewer did not print its address"; }
+ok "viewer printed its address: $URL"
+
+# Plain HTTP: the page, the bundled three.js, nothing outside the page's files.
+[ "$(curl -s -o /dev/null -w '%{http_code}' "$URL")" = 200 ] || fail "GET / did not answer 200"
+[ "$(curl -s -o /dev/null -w '%{http_code}' "${URL}three/three.module.js")" = 200 ] || fail "three.js is not served"
+[ "$(curl -s --path-as-is -o /dev/null -w '%{http_code}' "${URL}../../../etc/passwd")" = 404 ] || fail "a path outside the page was served"
+ok "page and three.js served; paths outside them are not"
+
+# The page in a real browser.
+CHROMIUM="$CHROMIUM" node "$BROWSER_DIR/check_viewer.mjs" "$URL" "$SHOT" 5 >"$WORK/page.json" || fail "the browser check failed"
+python3 - "$WORK" <<'PY' || fail "what the page drew does not match what was published (above)"
+import json, sys
+work = sys.argv[1]
+page = json.load(open(f"{work}/page.json"))
+published = {}
+for t in ("raw", "fused", "truth"):
+    for line in open(f"{work}/{t}.jsonl"):
+        s = json.loads(line)["data"]
+        n = sum(1 for j in s["joints"] if j["confidence"] > 0)
+        published[(s["sensor_id"], s["person_id"], s["frame_number"])] = n
+problems = []
+def check(cond, what):
+    if not cond: problems.append(what)
+check(not page["page_errors"], f"page errors: {page['page_errors']}")
+check(page["sensors"] == 2, f"{page['sensors']} sensors drawn, expected 2 with frustums")
+check(page["received_per_s"] >= 25, f"page received {page['received_per_s']:.1f} frames/s")
+check(page["drawn_per_s"] >= 15, f"page drew {page['drawn_per_s']:.1f} frames/s")
+compared = missing = 0
+streams = set()
+for snap in page["snapshots"]:
+    kinds = [s["kind"] for s in snap["list"]]
+    check(snap["skeletons"] == len(snap["list"]) and snap["joints"] == sum(s["joints"] for s in snap["list"]),
+          f"page counts disagree with its list: {snap}")
+    check("fused" in kinds and "truth" in kinds and "raw" in kinds, f"a snapshot lacks fused, truth or raw: {kinds}")
+    for s in snap["list"]:
+        streams.add(s["stream"])
+        key = (s["stream"], s["person"], s["frame"])
+        if key not in published:
+            missing += 1
+            continue
+        compared += 1
+        check(published[key] == s["joints"], f"{key}: page drew {s['joints']} joints, published {published[key]} with confidence > 0")
+check(compared >= 40, f"only {compared} drawn skeletons found among the published ones ({missing} not found)")
+check(missing <= compared // 20, f"{missing} drawn skeletons not among the published ({compared} found)")
+check({"sensor1", "sensor2", "fused", "truth"} <= streams, f"streams drawn: {sorted(streams)}")
+t = page.get("toggle")
+check(t and t["after"] == t["before"] - 1 and not t["still_drawn"] and t["restored"], f"layer toggle: {t}")
+p = page["pause"]
+check(p["drawn_while_paused"] == 0 and p["received_while_paused"] >= 20 and p["drawn_after_resume"] > 0, f"pause: {p}")
+m = page["malformed"]
+check(any("unknown cmd 'rewind'" in e for e in m["errors"]) and m["still_receiving"] and m["connected"], f"malformed request: {m}")
+for p_ in problems: print("  " + p_)
+print(f"ok: the page drew {compared} skeletons matching the published ones (joint counts), streams {sorted(streams)}; "
+      f"received {page['received_per_s']:.1f} and drew {page['drawn_per_s']:.1f} frames/s; screenshot {page['screenshot']}")
+sys.exit(1 if problems else 0)
+PY
+
+# Load: 20 clients for 30 s (and the misbehaving ones); fusion's rate before and during.
+rate() { "$SKELGRAPH" topic hz skelgraph/skeleton/fused --window 5 --json --timeout 10 >"$WORK/hz_$1.json" && json_get "$WORK/hz_$1.json" 'round(d["rate_hz"], 1)'; }
+before=$(rate before)
+"$WS_LOAD" --port "$PORT" --clients 20 --seconds 30 >"$WORK/load.json" &
+load=$!
+sleep 10
+during=$(rate during)
+wait "$load" || fail "ws_load failed"
+kill -INT "$launch"
+wait "$launch" || fail "the launch did not end cleanly: $(tail -5 "$WORK/launch.err")"
+python3 - "$WORK" "$before" "$during" <<'PY' || fail "the viewer under load (above)"
+import json, sys
+work, before, during = sys.argv[1], float(sys.argv[2]), float(sys.argv[3])
+load = json.load(open(f"{work}/load.json"))
+report = json.load(open(f"{work}/launch.json"))
+viewer = next(c for c in report["components"] if c["name"] == "viewer")["details"]
+mis = load["misbehaving"]
+problems = []
+def check(cond, what):
+    if not cond: problems.append(what)
+check(during >= 29.0 and during >= before - 1.0, f"fused rate {before} Hz before the load, {during} Hz during it")
+check(load["failed_clients"] == 0, f"{load['failed_clients']} clients failed: {[c['error'] for c in load['per_client'] if c['error']]}")
+check(load["frames_per_s_min"] >= 25, f"slowest client got {load['frames_per_s_min']:.1f} frames/s")
+check(load["delay_ms_late_median_max"] < 100, f"a client's median delay late in the run: {load['delay_ms_late_median_max']:.1f} ms")
+check(mis.get("errors_answered") == 6 and mis.get("still_open_after_garbage") and mis.get("closed_after_oversize"),
+      f"malformed client: {mis}")
+check(mis.get("churned_connections", 0) >= 20, f"reconnecting client: {mis}")
+check(viewer["peak_clients"] >= 22, f"peak clients {viewer['peak_clients']}")
+check(viewer["frames_dropped"] > 0, "the stalled client's frames were not dropped (buffered?)")
+check(viewer["bad_messages"] >= 7, f"bad messages counted: {viewer['bad_messages']}")
+for p in problems: print("  " + p)
+print(f"ok: {load['clients']} clients for {load['seconds']:.0f} s: {load['frames_per_s_min']:.1f}-{load['frames_per_s_median']:.1f} frames/s "
+      f"each, median delay <= {load['delay_ms_late_median_max']:.1f} ms; fused {before} Hz before, {during} Hz during; "
+      f"{viewer['frames_dropped']} frames dropped for the stalled client, {mis['churned_connections']} reconnects, "
+      f"{viewer['bad_messages']} bad messages answered")
+sys.exit(1 if problems else 0)
+PY

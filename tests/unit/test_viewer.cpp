@@ -1,0 +1,198 @@
+// The viewer's core: what a frame holds, which frames a slow client gets, and
+// which client requests are accepted.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "skelgraph/viewer/client_command.hpp"
+#include "skelgraph/viewer/outbox.hpp"
+#include "skelgraph/viewer/scene.hpp"
+
+using namespace skelgraph;
+using namespace skelgraph::viewer;
+
+namespace {
+
+constexpr std::int64_t kMs = 1'000'000;
+
+skeleton::Skeleton person(const std::string& sensor, std::uint32_t id, const std::string& frame, std::uint64_t n) {
+  skeleton::Skeleton s;
+  s.sensor_id = sensor;
+  s.person_id = id;
+  s.frame_id = frame;
+  s.frame_number = n;
+  for (std::size_t i = 0; i < skeleton::kJointCount; ++i) {
+    s.joints[i].position = Eigen::Vector3d(0.1 * static_cast<double>(i), 1.0, 2.0);
+    s.joints[i].confidence = skeleton::kTracked;
+  }
+  return s;
+}
+
+skeleton::SensorPose pose_of(const std::string& sensor) {
+  skeleton::SensorPose p;
+  p.sensor_id = sensor;
+  p.frame_id = "world";
+  // 90 degrees about +y, then 3 m along +x.
+  p.pose = Eigen::Translation3d(3.0, 0.0, 0.0) * Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY());
+  return p;
+}
+
+const nlohmann::json* find_skeleton(const nlohmann::json& frame, const std::string& stream) {
+  for (const auto& s : frame["skeletons"])
+    if (s["stream"] == stream) return &s;
+  return nullptr;
+}
+
+}  // namespace
+
+TEST(ViewerScene, JointStatesFromConfidence) {
+  EXPECT_EQ(joint_state(1.0f), 2);
+  EXPECT_EQ(joint_state(0.5f), 1);
+  EXPECT_EQ(joint_state(0.0f), 0);
+  EXPECT_EQ(joint_state(std::nanf("")), 0);
+  EXPECT_EQ(stream_kind("fused"), StreamKind::Fused);
+  EXPECT_EQ(stream_kind("truth"), StreamKind::Truth);
+  EXPECT_EQ(stream_kind("kinect2"), StreamKind::Raw);
+}
+
+TEST(ViewerScene, RawSkeletonsArePlacedWithTheirSensorsPose) {
+  Scene scene;
+  auto s = person("sensor1", 1, "sensor1", 7);
+  s.joints[3].confidence = skeleton::kInferred;
+  s.joints[4].confidence = skeleton::kLost;
+  scene.on_skeleton(s, 0);  // no pose yet: counted, not drawn
+  auto f = scene.frame(1 * kMs);
+  EXPECT_EQ(f["skeletons"].size(), 0u);
+  EXPECT_EQ(f["unplaced"], nlohmann::json::array({"sensor1"}));
+  EXPECT_EQ(f["streams"]["sensor1"]["unplaced"], 1);
+
+  EXPECT_FALSE(scene.on_pose([] {
+    auto p = pose_of("sensor1");
+    p.frame_id = "mocap";
+    return p;
+  }()));
+  ASSERT_TRUE(scene.on_pose(pose_of("sensor1")));
+  scene.on_skeleton(s, 10 * kMs);
+  f = scene.frame(20 * kMs);
+  const auto* drawn = find_skeleton(f, "sensor1");
+  ASSERT_NE(drawn, nullptr);
+  EXPECT_EQ((*drawn)["kind"], "raw");
+  EXPECT_EQ((*drawn)["frame"], 7);
+  EXPECT_EQ((*drawn)["age_ms"], 10);
+  const auto& joints = (*drawn)["joints"];
+  ASSERT_EQ(joints.size(), skeleton::kJointCount);
+  // Joint 0 at (0, 1, 2) in the sensor frame: rotated 90 degrees about y -> (2, 1, 0), then +3 m in x.
+  EXPECT_NEAR(joints[0][0].get<double>(), 5.0, 1e-9);
+  EXPECT_NEAR(joints[0][1].get<double>(), 1.0, 1e-9);
+  EXPECT_NEAR(joints[0][2].get<double>(), 0.0, 1e-9);
+  EXPECT_EQ(joints[0][3], 2);
+  EXPECT_EQ(joints[3][3], 1);
+  EXPECT_EQ(joints[4], nlohmann::json::array({0, 0, 0, 0}));
+  EXPECT_EQ(f["unplaced"].size(), 0u);
+  ASSERT_EQ(f["sensors"].size(), 1u);
+  EXPECT_EQ(f["sensors"][0]["position"], nlohmann::json::array({3.0, 0.0, 0.0}));
+}
+
+TEST(ViewerScene, WorldSkeletonsPassAndOldOnesGo) {
+  SceneOptions o;
+  o.max_age_ns = 100 * kMs;
+  Scene scene(o);
+  scene.on_skeleton(person("fused", 1, "world", 1), 0);
+  scene.on_skeleton(person("fused", 2, "world", 1), 50 * kMs);
+  scene.on_skeleton(person("truth", 1, "world", 1), 50 * kMs);
+  auto f = scene.frame(80 * kMs);
+  EXPECT_EQ(f["skeletons"].size(), 3u);
+  EXPECT_NEAR(find_skeleton(f, "fused")->at("joints")[1][0].get<double>(), 0.1, 1e-9);
+  f = scene.frame(120 * kMs);  // person 1 of fused is 120 ms old
+  EXPECT_EQ(f["skeletons"].size(), 2u);
+  EXPECT_EQ(scene.skeletons_held(), 2u);
+  EXPECT_GT(f["seq"].get<int>(), 1);
+}
+
+TEST(ViewerScene, RatesPerStream) {
+  Scene scene;
+  for (int i = 0; i <= 30; ++i) scene.on_skeleton(person("fused", 1, "world", i), i * 33 * kMs);
+  const auto f = scene.frame(30 * 33 * kMs);
+  EXPECT_NEAR(f["streams"]["fused"]["rate_hz"].get<double>(), 30.3, 0.1);
+  EXPECT_EQ(f["streams"]["fused"]["kind"], "fused");
+}
+
+TEST(ViewerScene, GesturesAndStatusExpire) {
+  SceneOptions o;
+  o.gesture_hold_ns = 1000 * kMs;
+  o.status_max_age_ns = 2000 * kMs;
+  Scene scene(o);
+  scene.on_gesture({{"label", "pointing"}, {"person_id", 1}}, 0);
+  scene.on_status("fusion", {{"component_name", "fusion"}, {"state", "STATE_DEGRADED"}}, 0);
+  scene.on_status("fusion", {{"component_name", "fusion"}, {"state", "STATE_OK"}}, 500 * kMs);
+  scene.on_player("play", {{"player", "play"}, {"paused", true}});
+  auto f = scene.frame(900 * kMs);
+  ASSERT_EQ(f["gestures"].size(), 1u);
+  EXPECT_EQ(f["gestures"][0]["age_ms"], 900);
+  ASSERT_EQ(f["status"].size(), 1u);
+  EXPECT_EQ(f["status"][0]["state"], "STATE_OK");
+  EXPECT_EQ(f["players"].size(), 1u);
+  f = scene.frame(1100 * kMs);
+  EXPECT_EQ(f["gestures"].size(), 0u);
+  EXPECT_EQ(f["status"].size(), 1u);
+  f = scene.frame(2600 * kMs);
+  EXPECT_EQ(f["status"].size(), 0u);
+}
+
+TEST(ViewerOutbox, ASlowClientGetsTheNewestFrameOnly) {
+  Outbox box(2);
+  auto msg = [](const char* s) { return std::make_shared<const std::string>(s); };
+  EXPECT_TRUE(box.empty());
+  EXPECT_EQ(box.take(), nullptr);
+  box.push_frame(msg("f1"));
+  box.push_frame(msg("f2"));
+  box.push_frame(msg("f3"));
+  EXPECT_EQ(box.dropped_frames(), 2u);
+  box.push_reply(msg("r1"));
+  box.push_reply(msg("r2"));
+  box.push_reply(msg("r3"));  // over max_replies: r1 goes
+  EXPECT_EQ(box.dropped_replies(), 1u);
+  EXPECT_EQ(*box.take(), "r2");
+  EXPECT_EQ(*box.take(), "r3");
+  EXPECT_EQ(*box.take(), "f3");
+  EXPECT_TRUE(box.empty());
+  EXPECT_EQ(box.take(), nullptr);
+  box.push_frame(msg("f4"));  // the slot was emptied by take(): nothing dropped
+  EXPECT_EQ(box.dropped_frames(), 2u);
+}
+
+TEST(ViewerClientCommand, AcceptsPlayAndPing) {
+  auto p = parse_client_message(R"({"cmd":"play","kind":"speed","value":2,"target":"player"})");
+  ASSERT_TRUE(p.ok) << p.error;
+  EXPECT_EQ(p.command.type, ClientCommand::Type::Play);
+  EXPECT_EQ(p.command.play_kind, "speed");
+  EXPECT_EQ(p.command.value, 2.0);
+  EXPECT_EQ(p.command.target, "player");
+  p = parse_client_message(R"({"cmd":"play","kind":"step"})");
+  ASSERT_TRUE(p.ok);
+  EXPECT_EQ(p.command.value, 1.0);
+  p = parse_client_message(R"({"cmd":"ping","id":"abc"})");
+  ASSERT_TRUE(p.ok);
+  EXPECT_EQ(p.command.ping_id, "abc");
+}
+
+TEST(ViewerClientCommand, RefusesMalformedRequestsSayingWhy) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"not json", "not JSON"},
+      {"[1]", "JSON object"},
+      {R"({"kind":"pause"})", "\"cmd\""},
+      {R"({"cmd":"rewind"})", "unknown cmd 'rewind'"},
+      {R"({"cmd":"play"})", "\"kind\""},
+      {R"({"cmd":"play","kind":"seek"})", "unknown kind 'seek'"},
+      {R"({"cmd":"play","kind":"speed"})", "expected \"value\""},
+      {R"({"cmd":"play","kind":"speed","value":"fast"})", "must be a number"},
+      {R"({"cmd":"play","kind":"pause","target":7})", "\"target\""},
+      {R"({"cmd":"play","kind":"pause","target":")" + std::string(80, 'a') + "\"}", "longer than 63"},
+      {std::string(kMaxClientMessage + 1, ' '), "at most"},
+  };
+  for (const auto& [text, why] : cases) {
+    const auto p = parse_client_message(text);
+    EXPECT_FALSE(p.ok) << text;
+    EXPECT_NE(p.error.find(why), std::string::npos) << text << " -> " << p.error;
+  }
+}
