@@ -41,6 +41,7 @@ const char* to_string(PlayKind k) {
     case PLAY_RESUME: return "RESUME";
     case PLAY_STEP: return "STEP";
     case PLAY_SPEED: return "SPEED";
+    case PLAY_SEEK: return "SEEK";
   }
   return "UNKNOWN";
 }
@@ -169,7 +170,8 @@ void to_json(nlohmann::json& j, const PlayControl& v) {
 void to_json(nlohmann::json& j, const PlayState& v) {
   j = {{"player", v.player().to_string()}, {"paused", v.paused()},     {"speed", v.speed()},
        {"frames", v.frames()},             {"frame_count", v.frame_count()}, {"at_end", v.at_end()},
-       {"request_id", v.request_id().to_string()}, {"error", v.error().to_string()}};
+       {"request_id", v.request_id().to_string()}, {"error", v.error().to_string()},
+       {"position_s", v.position_s()}, {"duration_s", v.duration_s()}};
 }
 
 }  // namespace skelgraph::msg

@@ -1,6 +1,7 @@
 // Pause, resume, step and speed of a player of recordings (PlayGate).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
 
 #include "skelgraph/runtime/play_gate.hpp"
@@ -64,4 +65,21 @@ TEST(PlayGate, SpeedChangesRestartPacingAndBadRequestsAreRefused) {
   }
   EXPECT_FALSE(g.paused());  // refused steps changed nothing
   EXPECT_THROW(PlayGate(-1.0), std::invalid_argument);
+}
+
+TEST(PlayGate, SeeksKeepPausedOrPlayingAndAreTakenOnce) {
+  PlayGate gate(1.0, true);
+  EXPECT_EQ(gate.take_seek(), std::nullopt);
+  EXPECT_EQ(gate.apply(PlayGate::Kind::Seek, 12.5), "");
+  EXPECT_EQ(gate.apply(PlayGate::Kind::Seek, 3.0), "");  // the latest wins
+  EXPECT_TRUE(gate.paused());
+  EXPECT_TRUE(gate.take_repace());
+  EXPECT_EQ(gate.take_seek(), 3.0);
+  EXPECT_EQ(gate.take_seek(), std::nullopt);
+  EXPECT_EQ(gate.apply(PlayGate::Kind::Resume), "");
+  EXPECT_EQ(gate.apply(PlayGate::Kind::Seek, 0.0), "");
+  EXPECT_FALSE(gate.paused());
+  EXPECT_NE(gate.apply(PlayGate::Kind::Seek, -1.0).find("0 or more"), std::string::npos);
+  EXPECT_NE(gate.apply(PlayGate::Kind::Seek, std::nan("")), "");
+  EXPECT_EQ(gate.take_seek(), 0.0);
 }

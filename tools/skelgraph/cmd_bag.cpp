@@ -372,18 +372,31 @@ int merge(const std::vector<std::string>& files, const std::string& out_path, mc
 }  // namespace
 
 // Runs one component of `kind` with parameters given as text.
+struct ComponentRun {
+  std::string name, kind;
+  std::vector<runtime::RawParam> raw;
+};
+
+int run_components(GlobalOptions& g, const std::vector<ComponentRun>& list, const RunOptions& ro) {
+  const auto registry = runtime::builtin_registry();
+  std::vector<runtime::ResolvedComponent> graph;
+  for (const auto& r : list) {
+    runtime::ResolvedComponent c;
+    c.name = r.name;
+    c.kind = r.kind;
+    try {
+      c.params = registry.find(r.kind)->info.params.resolve(r.raw, "component '" + r.name + "'");
+    } catch (const runtime::ParamError& e) {
+      throw UsageError(e.what());
+    }
+    graph.push_back(std::move(c));
+  }
+  return user_input([&] { return run_graph(registry, make_config(g), graph, ro, nullptr); });
+}
+
 int run_component(GlobalOptions& g, const std::string& kind, const std::vector<runtime::RawParam>& raw,
                   const RunOptions& ro) {
-  const auto registry = runtime::builtin_registry();
-  runtime::ResolvedComponent c;
-  c.name = kind;
-  c.kind = kind;
-  try {
-    c.params = registry.find(kind)->info.params.resolve(raw, "bag");
-  } catch (const runtime::ParamError& e) {
-    throw UsageError(e.what());
-  }
-  return user_input([&] { return run_graph(registry, make_config(g), {c}, ro, nullptr); });
+  return run_components(g, {{kind, kind, raw}}, ro);
 }
 
 void add_bag_command(CLI::App& app, GlobalOptions& g, Action& run) {
@@ -443,6 +456,39 @@ void add_bag_command(CLI::App& app, GlobalOptions& g, Action& run) {
                                             {"loop", r->loop ? "true" : "false", "bag play"}};
       if (!r->topics.empty()) raw.push_back({"topics", r->topics, "bag play"});
       return run_component(g, "bag_player", raw, r->run);
+    };
+  });
+
+  struct ViewOpts {
+    std::string address = "127.0.0.1";
+    int port = 8080;
+    double rate = 1.0;
+    bool paused = false, loop = false;
+  };
+  auto v = std::make_shared<ViewOpts>();
+  auto* view = app.add_subcommand(
+      "view", "A recording in the browser: plays it (bag_player, held at the end) with the viewer; the page has a timeline (seek, speed, pause, step)");
+  view->add_option("file", o->file, "MCAP file")->required()->check(CLI::ExistingFile);
+  view->add_option("--address", v->address, "where the page is served (0.0.0.0: every interface)");
+  view->add_option("--port", v->port, "TCP port of the page (0: any free port)")->check(CLI::Range(0, 65535));
+  view->add_option("--rate", v->rate, "speed at start: 1 = as recorded")->check(kPositive);
+  view->add_flag("--paused", v->paused, "start paused");
+  view->add_flag("--loop", v->loop, "start again at the end");
+  add_run_options(*view, r->run);
+  add_dds_options(*view, g);
+  view->callback([o, v, r, &g, &run] {
+    run = [o, v, r, &g] {
+      const auto b = [](bool x) { return std::string(x ? "true" : "false"); };
+      return run_components(g,
+                            {{"player", "bag_player",
+                              {{"file", o->file, "view"},
+                               {"rate", std::to_string(v->rate), "view"},
+                               {"paused", b(v->paused), "view"},
+                               {"loop", b(v->loop), "view"},
+                               {"hold_at_end", "true", "view"}}},
+                             {"viewer", "viewer",
+                              {{"address", v->address, "view"}, {"port", std::to_string(v->port), "view"}}}},
+                            r->run);
     };
   });
 

@@ -32,6 +32,15 @@ std::string describe(const msg::PlayState& s) {
   std::string text = s.player().to_string() + ": " + (s.at_end() ? "at the end" : s.paused() ? "paused" : "playing") +
                      ", speed " + nlohmann::json(s.speed()).dump() + ", frame " + std::to_string(s.frames());
   if (s.frame_count() >= 0) text += " of " + std::to_string(s.frame_count());
+  if (s.position_s() >= 0) {
+    char pos[64];
+    std::snprintf(pos, sizeof(pos), ", at %.2f s", s.position_s());
+    text += pos;
+    if (s.duration_s() >= 0) {
+      std::snprintf(pos, sizeof(pos), " of %.2f s", s.duration_s());
+      text += pos;
+    }
+  }
   if (s.error().size() > 0) text += "; refused: " + s.error().to_string();
   return text;
 }
@@ -67,7 +76,8 @@ int request(const runtime::DdsConfig& config, std::optional<msg::PlayKind> kind,
   std::unique_lock<std::mutex> lock(mutex);
   if (!kind) {
     if (!cv.wait_until(lock, deadline, [&] { return !answers.empty(); })) throw std::runtime_error(who + where);
-    cv.wait_for(lock, std::chrono::milliseconds(500));  // the other players' states
+    // The other players' states, and the rest of the kept history (late joiners get it oldest first).
+    cv.wait_for(lock, std::chrono::milliseconds(500), [] { return false; });
   } else {
     lock.unlock();
     if (!control.wait_for_matched(1, timeout)) throw std::runtime_error(who + where);
@@ -85,7 +95,7 @@ int request(const runtime::DdsConfig& config, std::optional<msg::PlayKind> kind,
                     [&] { return !answers.empty(); });
     }
     if (answers.empty()) throw std::runtime_error(who + " answered within " + nlohmann::json(o.timeout).dump() + " s");
-    if (o.target.empty()) cv.wait_for(lock, std::chrono::milliseconds(500));
+    if (o.target.empty()) cv.wait_for(lock, std::chrono::milliseconds(500), [] { return false; });
   }
   int rc = 0;
   nlohmann::json out = nlohmann::json::array();
@@ -106,7 +116,7 @@ int request(const runtime::DdsConfig& config, std::optional<msg::PlayKind> kind,
 void add_player_command(CLI::App& app, GlobalOptions& g, Action& run) {
   auto o = std::make_shared<PlayerOpts>();
   auto* cmd = app.add_subcommand(
-      "player", "Pause, resume, step or speed up the running players of recordings (openni2 on an .oni file)");
+      "player", "Pause, resume, step, speed up or seek the running players of recordings (openni2 on an .oni file, bag play)");
   cmd->require_subcommand(1);
   auto* pause = cmd->add_subcommand("pause", "Pause: no frame until resume or step");
   auto* resume = cmd->add_subcommand("resume", "Play on at the player's speed, paced from now");
@@ -116,8 +126,10 @@ void add_player_command(CLI::App& app, GlobalOptions& g, Action& run) {
   speed->add_option("SPEED", o->value, "1 real time, 2 twice as fast, 0 as fast as frames can be read")
       ->required()
       ->check(CLI::Range(0.0, 1000.0));
+  auto* seek = cmd->add_subcommand("seek", "Go to a position in the recording (players that can seek: bag_player)");
+  seek->add_option("SECONDS", o->value, "seconds from the start of the recording")->required()->check(CLI::Range(0.0, 1e7));
   auto* st = cmd->add_subcommand("state", "Print the players' state");
-  for (auto* c : {pause, resume, step, speed, st}) {
+  for (auto* c : {pause, resume, step, speed, seek, st}) {
     c->add_option("--target", o->target, "the player's component name (default: every player)");
     c->add_option("--timeout", o->timeout, "seconds to wait for the players")->check(kPositive);
     c->add_flag("--json", o->json, "the players' states as a JSON array");
@@ -130,6 +142,7 @@ void add_player_command(CLI::App& app, GlobalOptions& g, Action& run) {
   bind(resume, msg::PLAY_RESUME);
   bind(step, msg::PLAY_STEP);
   bind(speed, msg::PLAY_SPEED);
+  bind(seek, msg::PLAY_SEEK);
   bind(st, std::nullopt);
 }
 

@@ -45,10 +45,17 @@ OpenNI2Component::OpenNI2Component(runtime::Context& ctx, const runtime::Params&
   finite_ = source_->is_file() && !options_.repeat;
   description_ = source_->description();
   if (source_->is_file()) {
-    gate_ = runtime::PlayGate(options_.speed, params.get<bool>("paused"));
-    state_pub_ = std::make_unique<runtime::Publisher<msg::PlayState>>(ctx, runtime::topics::kPlayState);
-    play_sub_ = std::make_unique<runtime::Subscription<msg::PlayControl>>(
-        ctx, runtime::topics::kPlayControl, [this](const msg::PlayControl& c, const runtime::SampleMeta&) { on_play(c); });
+    player_ = std::make_unique<runtime::PlayerLink>(
+        ctx, runtime::PlayGate(options_.speed, params.get<bool>("paused")),
+        [this] {
+          std::lock_guard<std::mutex> lock(mutex_);
+          runtime::PlayerLink::Progress p;
+          p.frames = published_;
+          p.frame_count = source_->frame_count();
+          p.at_end = finished_;
+          return p;
+        },
+        /*can_seek=*/false);
   } else if (params.get<bool>("paused")) {
     throw std::invalid_argument("openni2: paused is for recordings, not devices");
   }
@@ -69,7 +76,7 @@ void OpenNI2Component::on_start() {
     ctx_.set_health(runtime::HealthState::Ok,
                     "the device reports no field of view: Kinect-like intrinsics assumed");
   }
-  if (state_pub_) publish_state("", "");
+  if (player_) player_->publish_state();
   thread_ = std::thread([this] { run(); });
 }
 
@@ -88,47 +95,6 @@ void OpenNI2Component::on_sync(const msg::SyncCommand& cmd, bool session_topic) 
   } else if (cmd.kind() == msg::SYNC_STOP && session_topic) {
     last_stopped_ = cmd.session_id();  // a late joiner: that session is over
   }
-}
-
-void OpenNI2Component::on_play(const msg::PlayControl& c) {
-  const std::string target = c.target().to_string(), id = c.request_id().to_string();
-  if (!target.empty() && target != ctx_.name()) return;
-  std::string error;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    if (!id.empty()) {
-      if (std::find(handled_requests_.begin(), handled_requests_.end(), id) != handled_requests_.end()) return;
-      handled_requests_.push_back(id);
-      if (handled_requests_.size() > 32) handled_requests_.pop_front();
-    }
-    using K = runtime::PlayGate::Kind;
-    const K kind = c.kind() == msg::PLAY_PAUSE    ? K::Pause
-                   : c.kind() == msg::PLAY_RESUME ? K::Resume
-                   : c.kind() == msg::PLAY_STEP   ? K::Step
-                                                  : K::Speed;
-    error = gate_.apply(kind, c.value());
-    if (error.empty() && kind == K::Step) {
-      step_request_ = id;  // answered once the frames are out
-      return;
-    }
-  }
-  publish_state(id, error);
-}
-
-void OpenNI2Component::publish_state(const std::string& request_id, const std::string& error) {
-  msg::PlayState s;
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    s.player(ctx_.name().substr(0, 64));
-    s.paused(gate_.paused());
-    s.speed(gate_.speed());
-    s.frames(published_);
-    s.frame_count(source_->frame_count());
-    s.at_end(finished_);
-    s.request_id(request_id.substr(0, 64));
-    s.error(error.substr(0, 128));
-  }
-  state_pub_->publish(s);
 }
 
 void OpenNI2Component::run() {
@@ -157,20 +123,19 @@ void OpenNI2Component::run() {
           recording_session_ = *want;
         }
       }
-      if (state_pub_) {
+      if (player_) {
         // A player: wait while paused; steps come without waiting; a new speed
         // or a resume paces afresh from the next frame.
         bool deliver = false, repace = false, stepping = false;
         double speed = 1.0;
-        {
-          std::lock_guard<std::mutex> lock(mutex_);
-          deliver = gate_.may_deliver();
-          repace = gate_.take_repace();
-          stepping = gate_.paused();
-          speed = gate_.speed();
-        }
+        player_->with_gate([&](runtime::PlayGate& g) {
+          deliver = g.may_deliver();
+          repace = g.take_repace();
+          stepping = g.paused();
+          speed = g.speed();
+        });
         if (!deliver) {
-          std::this_thread::sleep_for(std::chrono::milliseconds(5));
+          player_->wait_for_request(std::chrono::milliseconds(5));
           continue;
         }
         if (repace || stepping) source_->set_speed(speed);
@@ -178,24 +143,15 @@ void OpenNI2Component::run() {
       auto image = source_->next(std::chrono::milliseconds(100));
       if (image) {
         depth_pub_.publish(depth::to_msg(std::move(*image)));
-        std::string answer;
         {
           std::lock_guard<std::mutex> lock(mutex_);
           ++published_;
-          if (gate_.delivered()) answer = std::exchange(step_request_, "");
         }
-        if (!answer.empty()) publish_state(answer, "");
+        if (player_) player_->delivered();
       } else if (source_->at_end()) {
         finished_ = true;
         ctx_.set_health(runtime::HealthState::Ok, "end of recording");
-        if (state_pub_) {
-          std::string pending;
-          {
-            std::lock_guard<std::mutex> lock(mutex_);
-            pending = std::exchange(step_request_, "");
-          }
-          publish_state(pending, pending.empty() ? "" : "the recording ended before the steps were done");
-        }
+        if (player_) player_->at_end();
         break;
       }
     }
@@ -238,8 +194,8 @@ nlohmann::json OpenNI2Component::details() const {
           {"intrinsics_from_device", source_->intrinsics_from_device()},
           {"frames_in_recording", source_->frame_count()},
           {"published", published_},
-          {"paused", gate_.paused()},
-          {"speed", state_pub_ ? gate_.speed() : 0.0},
+          {"paused", player_ ? player_->with_gate([](runtime::PlayGate& g) { return g.paused(); }) : false},
+          {"speed", player_ ? player_->with_gate([](runtime::PlayGate& g) { return g.speed(); }) : 0.0},
           {"recordings", files_},
           {"recorded_frames", files_frames_},
           {"error", error_}};

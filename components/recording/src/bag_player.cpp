@@ -13,6 +13,8 @@ runtime::ComponentInfo BagPlayer::describe() {
   info.params.add_string("file", "", "the recording (MCAP)")
       .add_double("rate", 1.0, "speed: 1 = as recorded, 2 = twice as fast", 0.01, 1000.0)
       .add_bool("loop", false, "start again at the end")
+      .add_bool("paused", false, "start paused (resume, step or seek on skelgraph/play/control)")
+      .add_bool("hold_at_end", false, "at the end, wait for a seek instead of finishing")
       .add_double("wait_s", 2.0, "before playing, wait up to this long for every topic to have a reader", 0.0, 60.0)
       .add_double("reorder_s", 2.0, "messages this much out of log-time order in the file are played in order", 0.0, 60.0)
       .add_string_list("topics", {}, "only these topics (default: all but skelgraph/status)");
@@ -31,6 +33,7 @@ BagPlayer::BagPlayer(runtime::Context& ctx, const runtime::Params& params)
       file_(params.get<std::string>("file")),
       rate_(params.get<double>("rate")),
       loop_(params.get<bool>("loop")),
+      hold_at_end_(params.get<bool>("hold_at_end")),
       wait_ns_(static_cast<std::int64_t>(params.get<double>("wait_s") * 1e9)),
       reorder_ns_(static_cast<std::uint64_t>(params.get<double>("reorder_s") * 1e9)),
       reader_(open_recording(file_)) {
@@ -56,17 +59,35 @@ BagPlayer::BagPlayer(runtime::Context& ctx, const runtime::Params& params)
       publisher_of_channel_[id] = publishers_.size();
       publishers_.push_back(std::make_unique<runtime::RawPublisher>(ctx, ch.topic, type, keyed, qos));
       publisher_topics_.push_back(ch.topic);
+      publisher_is_state_.push_back(qos.durability == runtime::Durability::TransientLocal);
     }
     per_pass_ += count;
     any = true;
   }
   if (!any) throw std::invalid_argument(file_ + ": no messages to play");
   first_log_time_ = summary.message_start_time;
+  last_log_time_ = std::max(summary.message_end_time, first_log_time_);
+  position_log_ = first_log_time_;
+  player_ = std::make_unique<runtime::PlayerLink>(ctx, runtime::PlayGate(rate_, params.get<bool>("paused")),
+                                                  [this] { return progress(); }, /*can_seek=*/true);
+}
+
+runtime::PlayerLink::Progress BagPlayer::progress() const {
+  runtime::PlayerLink::Progress p;
+  p.frames = published_;
+  p.frame_count = static_cast<std::int64_t>(per_pass_);
+  p.at_end = at_end_;
+  p.position_s = static_cast<double>(position_log_.load() - first_log_time_) / 1e9;
+  p.duration_s = static_cast<double>(last_log_time_ - first_log_time_) / 1e9;
+  return p;
 }
 
 BagPlayer::~BagPlayer() { on_shutdown(); }
 
-void BagPlayer::on_start() { thread_ = std::thread([this] { run(); }); }
+void BagPlayer::on_start() {
+  player_->publish_state();
+  thread_ = std::thread([this] { run(); });
+}
 
 void BagPlayer::on_shutdown() {
   {
@@ -80,11 +101,37 @@ void BagPlayer::on_shutdown() {
 void BagPlayer::run() {
   try {
     wait_for_readers();
-    do {
-      start_mono_ns_ = runtime::Context::monotonic_ns();
-      play_once();
+    std::uint64_t from = first_log_time_;
+    for (;;) {
+      try {
+        at_end_ = false;
+        play_once(from);
+      } catch (const SeekTo& s) {
+        from = s.log_time;
+        position_log_ = from;
+        at_end_ = false;
+        player_->publish_state();
+        continue;
+      }
       ++loops_;
-    } while (loop_);
+      from = first_log_time_;
+      if (loop_) continue;
+      at_end_ = true;
+      player_->at_end();
+      if (!hold_at_end_) break;
+      // Held at the end: a seek plays on from there.
+      try {
+        for (;;) {
+          check_stop_and_seek();
+          player_->wait_for_request(std::chrono::milliseconds(50));
+        }
+      } catch (const SeekTo& s) {
+        from = s.log_time;
+        position_log_ = from;
+        at_end_ = false;
+        player_->publish_state();
+      }
+    }
     {  // let readers take (and reliable readers acknowledge) the last samples before the graph may stop
       std::unique_lock lock(mutex_);
       cv_.wait_for(lock, std::chrono::milliseconds(500), [this] { return stop_; });
@@ -115,19 +162,47 @@ void BagPlayer::wait_for_readers() {
   throw Stopped{};
 }
 
-void BagPlayer::wait_until_due(std::uint64_t log_time) {
-  const auto offset = static_cast<std::int64_t>(static_cast<double>(log_time - first_log_time_) / rate_);
-  const auto due = start_mono_ns_ + offset;
-  std::unique_lock lock(mutex_);
-  while (!stop_) {
-    const auto now = runtime::Context::monotonic_ns();
-    if (now >= due) return;
-    cv_.wait_for(lock, std::chrono::nanoseconds(std::min<std::int64_t>(due - now, 100'000'000)));
+void BagPlayer::check_stop_and_seek() {
+  {
+    std::lock_guard lock(mutex_);
+    if (stop_) throw Stopped{};
   }
-  throw Stopped{};
+  const auto seek = player_->with_gate([](runtime::PlayGate& g) { return g.take_seek(); });
+  if (seek) {
+    const auto offset = static_cast<std::uint64_t>(*seek * 1e9);
+    pace_mono_ = 0;  // pace afresh from the first message played
+    throw SeekTo{first_log_time_ + std::min(offset, last_log_time_ - first_log_time_)};
+  }
 }
 
-void BagPlayer::play_once() {
+void BagPlayer::wait_until_due(std::uint64_t log_time) {
+  for (;;) {
+    check_stop_and_seek();
+    bool deliver = false, repace = false, stepping = false;
+    double speed = 1.0;
+    player_->with_gate([&](runtime::PlayGate& g) {
+      deliver = g.may_deliver();
+      repace = g.take_repace();
+      stepping = g.paused();
+      speed = g.speed();
+    });
+    if (!deliver) {  // paused
+      player_->wait_for_request(std::chrono::milliseconds(50));
+      continue;
+    }
+    const auto now = runtime::Context::monotonic_ns();
+    if (repace || pace_mono_ == 0) {
+      pace_mono_ = now;
+      pace_log_ = log_time;
+    }
+    if (stepping || speed <= 0.0) return;  // steps, and speed 0, do not wait
+    const auto due = pace_mono_ + static_cast<std::int64_t>(static_cast<double>(log_time - pace_log_) / speed);
+    if (now >= due) return;
+    player_->wait_for_request(std::chrono::nanoseconds(std::min<std::int64_t>(due - now, 50'000'000)));
+  }
+}
+
+void BagPlayer::play_once(std::uint64_t from) {
   struct Pending {
     std::uint64_t log_time, order;
     std::size_t publisher;
@@ -143,9 +218,21 @@ void BagPlayer::play_once() {
     pending.pop();
     if (p.log_time < last_played) ++reordered_late_;  // further out of order than reorder_s
     last_played = std::max(last_played, p.log_time);
-    wait_until_due(std::max(p.log_time, first_log_time_));
+    const auto t = std::max(p.log_time, first_log_time_);
+    if (t < from) {  // before a seek's position: only the latest state matters
+      if (publisher_is_state_[p.publisher]) publishers_[p.publisher]->publish(p.sample);
+      return;
+    }
+    wait_until_due(t);
     if (publishers_[p.publisher]->publish(p.sample)) ++published_;
     else ++failed_;
+    position_log_ = t;
+    player_->delivered();
+    const auto now = runtime::Context::monotonic_ns();
+    if (now - last_state_ns_ >= 250'000'000) {
+      last_state_ns_ = now;
+      player_->publish_state();
+    }
   };
   reader_.for_each_message([&](const mcap::Channel& ch, const mcap::Schema*, const mcap::Message& m) {
     const auto it = publisher_of_channel_.find(ch.id);
@@ -170,6 +257,7 @@ std::string BagPlayer::summary() const {
 
 nlohmann::json BagPlayer::details() const {
   return {{"file", file_},           {"messages", per_pass_},        {"published", published_.load()},
+          {"position_s", progress().position_s}, {"duration_s", progress().duration_s},
           {"failed", failed_.load()}, {"passes", loops_.load()},      {"played_late", reordered_late_.load()},
           {"topics", publisher_topics_}};
 }

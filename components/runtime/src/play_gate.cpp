@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
 namespace skelgraph::runtime {
 
@@ -37,6 +38,11 @@ std::string PlayGate::apply(Kind kind, double value) {
       speed_ = value;
       repace_ = true;
       return "";
+    case Kind::Seek:
+      if (!std::isfinite(value) || value < 0.0) return "seek: the position must be 0 or more seconds";
+      seek_ = value;
+      repace_ = true;
+      return "";
   }
   return "unknown request";
 }
@@ -45,6 +51,8 @@ bool PlayGate::delivered() {
   if (!paused_ || steps_ == 0) return false;
   return --steps_ == 0;
 }
+
+std::optional<double> PlayGate::take_seek() { return std::exchange(seek_, std::nullopt); }
 
 bool PlayGate::take_repace() {
   const bool r = repace_;

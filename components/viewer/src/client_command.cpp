@@ -26,10 +26,11 @@ ParsedCommand parse_client_message(std::string_view text) {
   } else if (*cmd == "play") {
     c.type = ClientCommand::Type::Play;
     const auto kind = j.find("kind");
-    if (kind == j.end() || !kind->is_string()) return refuse("play: expected \"kind\": pause, resume, step or speed");
+    if (kind == j.end() || !kind->is_string()) return refuse("play: expected \"kind\": pause, resume, step, speed or seek");
     c.play_kind = kind->get<std::string>();
-    if (c.play_kind != "pause" && c.play_kind != "resume" && c.play_kind != "step" && c.play_kind != "speed")
-      return refuse("play: unknown kind '" + c.play_kind + "' (pause, resume, step, speed)");
+    if (c.play_kind != "pause" && c.play_kind != "resume" && c.play_kind != "step" && c.play_kind != "speed" &&
+        c.play_kind != "seek")
+      return refuse("play: unknown kind '" + c.play_kind.substr(0, 32) + "' (pause, resume, step, speed, seek)");
     if (const auto v = j.find("value"); v != j.end()) {
       if (!v->is_number()) return refuse("play: \"value\" must be a number");
       c.value = v->get<double>();
@@ -38,6 +39,8 @@ ParsedCommand parse_client_message(std::string_view text) {
       c.value = 1.0;
     } else if (c.play_kind == "speed") {
       return refuse("play speed: expected \"value\" (1 real time, 2 twice as fast)");
+    } else if (c.play_kind == "seek") {
+      return refuse("play seek: expected \"value\" (seconds from the start of the recording)");
     }
     if (const auto t = j.find("target"); t != j.end()) {
       if (!t->is_string()) return refuse("play: \"target\" must be a player's name");

@@ -112,6 +112,7 @@ std::string ViewerComponent::on_client_message(const std::string& text, bool& ba
   pc.kind(c.play_kind == "pause"    ? msg::PLAY_PAUSE
           : c.play_kind == "resume" ? msg::PLAY_RESUME
           : c.play_kind == "step"   ? msg::PLAY_STEP
+          : c.play_kind == "seek"   ? msg::PLAY_SEEK
                                     : msg::PLAY_SPEED);
   pc.value(c.value);
   const auto id = ctx_.name() + "-" + std::to_string(++play_requests_);

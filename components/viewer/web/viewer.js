@@ -214,6 +214,7 @@ function drawPlayers(list) {
       const div = document.createElement('div');
       div.dataset.player = p.player;
       div.innerHTML = `<div class="row"><b></b><span class="rate"></span></div>
+        <div class="row"><input type="range" class="timeline" min="0" max="1" step="0.01" value="0" style="flex:1"></div>
         <div class="row"><button data-k="pause">Pause</button><button data-k="resume">Play</button>
         <button data-k="step">Step</button><select><option>0.25</option><option>0.5</option>
         <option selected>1</option><option>2</option><option>4</option></select>x</div>`;
@@ -223,15 +224,28 @@ function drawPlayers(list) {
       }
       div.querySelector('select').addEventListener('change', (e) =>
         send({ cmd: 'play', kind: 'speed', target: p.player, value: Number(e.target.value) }));
+      const timeline = div.querySelector('.timeline');
+      timeline.addEventListener('input', () => { timeline.dataset.dragging = '1'; });
+      timeline.addEventListener('change', () => {
+        delete timeline.dataset.dragging;
+        send({ cmd: 'play', kind: 'seek', target: p.player, value: Number(timeline.value) });
+      });
       return div;
     }));
   }
   for (const p of list) {
     const div = el.querySelector(`[data-player="${CSS.escape(p.player)}"]`);
     if (!div) continue;
-    const total = p.frame_count >= 0 ? ` of ${p.frame_count}` : '';
+    const timeline = div.querySelector('.timeline');
+    const where = p.position_s >= 0 && p.duration_s >= 0 ? `${p.position_s.toFixed(1)} / ${p.duration_s.toFixed(1)} s`
+                                                          : `frame ${p.frames}${p.frame_count >= 0 ? ' of ' + p.frame_count : ''}`;
+    timeline.style.display = p.duration_s > 0 ? '' : 'none';
+    if (p.duration_s > 0 && !timeline.dataset.dragging) {
+      timeline.max = p.duration_s;
+      timeline.value = p.position_s;
+    }
     div.querySelector('.rate').textContent =
-      `${p.paused ? 'paused' : 'playing'} ${p.speed}x, frame ${p.frames}${total}${p.at_end ? ', at the end' : ''}`;
+      `${p.paused ? 'paused' : 'playing'} ${p.speed}x, ${where}${p.at_end ? ', at the end' : ''}${p.error ? ' (' + p.error + ')' : ''}`;
   }
 }
 
@@ -255,6 +269,7 @@ function apply(frame) {
     l.rate.textContent = `${st.rate_hz.toFixed(1)} Hz${frame.unplaced.includes(name) ? ', no pose yet' : ''}`;
   }
   stats.gestures = frame.gestures;
+  stats.players = frame.players;
   drawGestures(frame.gestures);
   drawStatus(frame.status);
   drawPlayers(frame.players);

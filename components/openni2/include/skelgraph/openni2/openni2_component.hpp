@@ -17,7 +17,7 @@
 
 #include "skelgraph/openni2/oni_source.hpp"
 #include "skelgraph/runtime/component.hpp"
-#include "skelgraph/runtime/play_gate.hpp"
+#include "skelgraph/runtime/player_link.hpp"
 #include "skelgraph/runtime/pubsub.hpp"
 
 namespace skelgraph::openni2 {
@@ -38,9 +38,7 @@ class OpenNI2Component final : public runtime::Component {
  private:
   void run();
   void on_sync(const msg::SyncCommand& cmd, bool session_topic);
-  void on_play(const msg::PlayControl& c);
   // The player's state, answering `request_id` (with `error` when refused).
-  void publish_state(const std::string& request_id, const std::string& error);
 
   OniOptions options_;
   std::string record_dir_;
@@ -50,17 +48,13 @@ class OpenNI2Component final : public runtime::Component {
   std::thread thread_;
   runtime::Publisher<msg::DepthFrame> depth_pub_;
   std::unique_ptr<runtime::Subscription<msg::SyncCommand>> sync_sub_, session_sub_;
-  std::unique_ptr<runtime::Publisher<msg::PlayState>> state_pub_;        // recordings only
-  std::unique_ptr<runtime::Subscription<msg::PlayControl>> play_sub_;    // recordings only
+  std::unique_ptr<runtime::PlayerLink> player_;  // recordings only: pause, step, speed; state
 
   mutable std::mutex mutex_;  // guards what follows
   std::optional<std::uint32_t> want_session_;  // a session to record (set by START, cleared by STOP)
   std::uint32_t recording_session_ = 0;        // what the thread records now (0: nothing)
   std::uint32_t last_stopped_ = 0;
   std::vector<std::string> files_;             // finished recordings
-  runtime::PlayGate gate_;                     // recordings: paused, stepping, speed
-  std::deque<std::string> handled_requests_;   // the latest request ids (requests are repeated until answered)
-  std::string step_request_;                   // answered when its steps are delivered
   std::uint64_t published_ = 0, files_frames_ = 0;
   std::string description_, error_;
 };

@@ -6,22 +6,27 @@
 // take_repace() says so.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 namespace skelgraph::runtime {
 
 class PlayGate {
  public:
-  enum class Kind { Pause, Resume, Step, Speed };
+  enum class Kind { Pause, Resume, Step, Speed, Seek };
 
   // Throws std::invalid_argument for a negative or non-finite speed.
   explicit PlayGate(double speed = 1.0, bool paused = false);
 
   // Applies a request. Returns why it is refused ("" when applied): a speed
   // that is negative, not finite or above 1000; a step of fewer than 1 or more
-  // than 1000000 frames, or not a whole number. A step pauses a running
-  // player and lets `value` frames through; pause cancels steps left.
+  // than 1000000 frames, or not a whole number; a seek to a negative or not
+  // finite position (seconds from the start). A step pauses a running player
+  // and lets `value` frames through; pause cancels steps left; a seek keeps
+  // the player paused or playing as it was and is taken by take_seek().
   std::string apply(Kind kind, double value = 0.0);
+  // Once per seek request: the position asked for (the latest, if several came).
+  std::optional<double> take_seek();
 
   bool may_deliver() const { return !paused_ || steps_ > 0; }
   // After each delivered frame: true when it was the last of a step request.
@@ -38,6 +43,7 @@ class PlayGate {
   bool paused_;
   std::uint64_t steps_ = 0;
   bool repace_ = false;
+  std::optional<double> seek_;
 };
 
 }  // namespace skelgraph::runtime
