@@ -15,8 +15,10 @@ live=$!
   --duration 14 --json >"$WORK/raw.json" 2>"$WORK/raw.err" &
 raw=$!
 "$SKELGRAPH" topic hz skelgraph/depth --json --window 3 --timeout 10 >"$WORK/hz.json" 2>"$WORK/hz.err" || fail "no depth: $(cat "$WORK/hz.err")"
-# Two Dummy devices publish: ~60 Hz together.
-json_check "$WORK/hz.json" '50 < d["rate_hz"] < 70'
+# Two Dummy devices publish: ~60 Hz together. More than one device can give
+# (30 Hz), with room for a loaded machine: a clean-clone run on 2 cores beside
+# test_depth_tracker and calib measured 48 Hz.
+json_check "$WORK/hz.json" '40 < d["rate_hz"] < 70'
 "$SKELGRAPH" topic echo skelgraph/depth --count 1 --json --timeout 5 >"$WORK/echo.json"
 json_check "$WORK/echo.json" 'd["data"]["width"] == 320 and d["data"]["height"] == 240 and d["data"]["depth_mm_count"] == 76800 and d["data"]["depth_mm_valid"] > 300'
 "$SKELGRAPH" sync start --label oni --timeout 10 >/dev/null || fail "sync start"

@@ -126,14 +126,7 @@ void OpenNI2Component::run() {
       if (player_) {
         // A player: wait while paused; steps come without waiting; a new speed
         // or a resume paces afresh from the next frame.
-        bool deliver = false, repace = false, stepping = false;
-        double speed = 1.0;
-        player_->with_gate([&](runtime::PlayGate& g) {
-          deliver = g.may_deliver();
-          repace = g.take_repace();
-          stepping = g.paused();
-          speed = g.speed();
-        });
+        const auto [deliver, repace, stepping, speed] = player_->turn();
         if (!deliver) {
           player_->wait_for_request(std::chrono::milliseconds(5));
           continue;

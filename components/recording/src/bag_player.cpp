@@ -178,14 +178,7 @@ void BagPlayer::check_stop_and_seek() {
 void BagPlayer::wait_until_due(std::uint64_t log_time) {
   for (;;) {
     check_stop_and_seek();
-    bool deliver = false, repace = false, stepping = false;
-    double speed = 1.0;
-    player_->with_gate([&](runtime::PlayGate& g) {
-      deliver = g.may_deliver();
-      repace = g.take_repace();
-      stepping = g.paused();
-      speed = g.speed();
-    });
+    const auto [deliver, repace, stepping, speed] = player_->turn();
     if (!deliver) {  // paused
       player_->wait_for_request(std::chrono::milliseconds(50));
       continue;

@@ -47,6 +47,11 @@ void PlayerLink::on_request(const msg::PlayControl& c) {
   publish_state(id, error);
 }
 
+PlayerLink::Turn PlayerLink::turn() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return Turn{gate_.may_deliver(), gate_.take_repace(), gate_.paused(), gate_.speed()};
+}
+
 void PlayerLink::wait_for_request(std::chrono::nanoseconds timeout) {
   std::unique_lock<std::mutex> lock(mutex_);
   const auto seen = requests_;

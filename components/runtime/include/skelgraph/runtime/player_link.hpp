@@ -33,6 +33,15 @@ class PlayerLink {
   // `progress` is called without the link's lock held; `can_seek` false refuses seeks.
   PlayerLink(Context& ctx, PlayGate gate, std::function<Progress()> progress, bool can_seek);
 
+  // What the player may do now, read under the lock: deliver a frame (not
+  // paused, or steps left), pace afresh (after resume, speed, step, seek),
+  // stepping (paused with steps: no waiting), at which speed.
+  struct Turn {
+    bool deliver = false, repace = false, stepping = false;
+    double speed = 1.0;
+  };
+  Turn turn();
+
   template <class F>
   auto with_gate(F&& f) {
     std::lock_guard<std::mutex> lock(mutex_);
