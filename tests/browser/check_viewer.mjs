@@ -44,6 +44,8 @@ try {
   out.drawn_per_s = (b.framesDrawn - a.framesDrawn) / dt;
   out.page_fps = b.fps;
   out.sensors = b.sensors;
+  out.gl = b.gl;
+  out.software_gl = b.software;
   out.snapshots = snapshots;
 
   // Layer toggle: hide the first sensor's skeleton.

@@ -18,7 +18,16 @@ window.skelgraphViewer = stats;
 
 // --- three.js scene -------------------------------------------------------
 const container = document.getElementById('view');
-const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+// Antialiasing costs a software renderer (SwiftShader, llvmpipe: no GPU) half its
+// frame rate; with a GPU it is nearly free.
+function glRenderer() {
+  const gl = document.createElement('canvas').getContext('webgl2');
+  const info = gl && gl.getExtension('WEBGL_debug_renderer_info');
+  return info ? String(gl.getParameter(info.UNMASKED_RENDERER_WEBGL)) : '';
+}
+stats.gl = glRenderer();
+stats.software = /swiftshader|llvmpipe|softpipe|software/i.test(stats.gl);
+const renderer = new THREE.WebGLRenderer({ antialias: !stats.software });
 renderer.setPixelRatio(window.devicePixelRatio);
 container.appendChild(renderer.domElement);
 const scene = new THREE.Scene();
