@@ -45,6 +45,8 @@ try {
   out.page_fps = b.fps;
   out.sensors = b.sensors;
   out.gl = b.gl;
+  out.gestures = { events: b.gestures.length, drawn: b.drawnGestures,
+                   text: await page.locator('#gestures').innerText() };
   out.software_gl = b.software;
   out.snapshots = snapshots;
 

@@ -5,11 +5,12 @@
 # published; the same with four sensors (bringup/sim_quad_viewer.yaml); then,
 # on the four-sensor graph, 20 WebSocket clients read for 30 s beside a
 # stalled, a malformed and a reconnecting one, and fusion must keep its rate.
-#   viewer.sh SKELGRAPH BROWSER_DIR WS_LOAD   (BROWSER_DIR: tests/browser installed by npm)
+#   viewer.sh SKELGRAPH BROWSER_DIR WS_LOAD PUBLISH_GESTURE   (BROWSER_DIR: tests/browser installed by npm)
 # The page's screenshot: $SKELGRAPH_VIEWER_SCREENSHOT, default build/viewer-screenshot.png.
 source "$(dirname "$0")/lib.sh"
 BROWSER_DIR=${2:?browser folder}
 WS_LOAD=${3:?ws_load}
+PUBLISH_GESTURE=${4:?publish_gesture}
 CHROMIUM=${CHROMIUM:-/usr/bin/chromium}
 [ -x "$CHROMIUM" ] || fail "no Chromium at $CHROMIUM (Debian package chromium; tools/run test installs it)"
 [ -f "$BROWSER_DIR/node_modules/playwright-core/package.json" ] || fail "playwright-core is not installed in $BROWSER_DIR (ctest fixture browser_install)"
@@ -36,6 +37,8 @@ browser_check() {
   [ "$(curl -s -o /dev/null -w '%{http_code}' "${URL}three/three.module.js")" = 200 ] || fail "three.js is not served"
   [ "$(curl -s --path-as-is -o /dev/null -w '%{http_code}' "${URL}../../../etc/passwd")" = 404 ] || fail "a path outside the page was served"
 
+  # A pointing gesture twice a second (the page draws its ray and target).
+  "$PUBLISH_GESTURE" 30 2>/dev/null &
   # The page in a real browser.
   local shot=$SHOT
   [ "$sensors" = 2 ] || shot=${SHOT%.png}-$sensors-sensors.png
@@ -80,6 +83,9 @@ t = page.get("toggle")
 check(t and t["after"] == t["before"] - 1 and not t["still_drawn"] and t["restored"], f"layer toggle: {t}")
 p = page["pause"]
 check(p["drawn_while_paused"] == 0 and p["received_while_paused"] >= 20 and p["drawn_after_resume"] > 0, f"pause: {p}")
+g = page["gestures"]
+check(g["events"] >= 1 and g["drawn"]["rays"] >= 1 and g["drawn"]["targets"] >= 1
+      and "pointing by person 7 (right arm) at floor" in g["text"], f"gestures: {g}")
 m = page["malformed"]
 check(any("unknown cmd 'rewind'" in e for e in m["errors"]) and m["still_receiving"] and m["connected"], f"malformed request: {m}")
 for p_ in problems: print("  " + p_)

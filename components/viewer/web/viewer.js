@@ -12,7 +12,8 @@ const FIXED_COLOURS = { fused: 0xff7f2a, truth: 0x5fdf5f };
 
 const stats = {
   connected: false, framesReceived: 0, framesDrawn: 0, fps: 0, lastSeq: 0, paused: false,
-  drawn: { skeletons: 0, joints: 0, list: [] }, sensors: 0, gestures: [], errors: [], replies: [],
+  drawn: { skeletons: 0, joints: 0, list: [] }, sensors: 0, gestures: [], drawnGestures: { rays: 0, targets: 0 },
+  errors: [], replies: [], players: [],
 };
 window.skelgraphViewer = stats;
 
@@ -169,10 +170,14 @@ scene.add(gestureGroup);
 const rayMaterial = new THREE.LineBasicMaterial({ color: 0xff4040 });
 const targetMaterial = new THREE.MeshBasicMaterial({ color: 0xff4040 });
 const targetGeometry = new THREE.SphereGeometry(0.06, 16, 12);
-function drawGestures(list) {
+function drawGestures(all) {
+  // The newest event of each person and label (a held gesture repeats).
+  const newest = new Map();
+  for (const g of all) newest.set(`${g.person_id}/${g.label}`, g);
+  const list = [...newest.values()];
   gestureGroup.clear();
   gestureGroup.visible = layers.get('gestures').visible;
-  const lines = [];
+  let rays = 0, targets = 0;
   for (const g of list) {
     if (!g.has_ray) continue;
     const o = g.ray_origin, dir = g.ray_direction;
@@ -180,12 +185,15 @@ function drawGestures(list) {
     const geom = new THREE.BufferGeometry();
     geom.setAttribute('position', new THREE.Float32BufferAttribute([o.x, o.y, o.z, ...end], 3));
     gestureGroup.add(new THREE.Line(geom, rayMaterial));
+    ++rays;
     if (g.has_target) {
+      ++targets;
       const m = new THREE.Mesh(targetGeometry, targetMaterial);
       m.position.set(...end);
       gestureGroup.add(m);
     }
   }
+  stats.drawnGestures = { rays, targets };
   const el = document.getElementById('gestures');
   if (list.length === 0) { el.textContent = 'none in the last seconds'; return; }
   el.replaceChildren(...list.map((g) => {

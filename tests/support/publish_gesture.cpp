@@ -1,0 +1,45 @@
+// publish_gesture: a pointing GestureEvent with a ray and a floor target,
+// twice a second for N seconds, on skelgraph/gesture/event (for the viewer's
+// browser test: the page must draw the ray and the target and name them).
+//   publish_gesture [SECONDS]        (default 10)
+// Every event: label "pointing", person 7, right arm, ray from (0, 1.4, 0)
+// towards (1, -1, 0)/sqrt(2), target (1.4, 0, 0) named "floor".
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <thread>
+
+#include "skelgraph/runtime/context.hpp"
+#include "skelgraph/runtime/pubsub.hpp"
+
+int main(int argc, char** argv) {
+  using namespace skelgraph;
+  const double seconds = argc > 1 ? std::atof(argv[1]) : 10.0;
+  auto config = runtime::DdsConfig::from_env();
+  runtime::Context ctx("publish_gesture", config);
+  runtime::Publisher<msg::GestureEvent> pub(ctx, runtime::topics::kGestureEvent);
+  msg::GestureEvent e;
+  e.label("pointing");
+  e.person_id(7);
+  e.source("skelgraph/skeleton/fused");
+  e.arm("right");
+  e.score(2.0);
+  e.confidence(1.0 - std::exp(-2.0));
+  e.has_ray(true);
+  e.has_target(true);
+  e.ray_origin().y(1.4);
+  e.ray_direction().x(std::sqrt(0.5));
+  e.ray_direction().y(-std::sqrt(0.5));
+  e.target().x(1.4);
+  e.target_name("floor");
+  const int count = static_cast<int>(seconds * 2);
+  for (int i = 0; i < count; ++i) {
+    e.start_stamp_ns(runtime::Context::now_ns() - 500'000'000);
+    e.end_stamp_ns(runtime::Context::now_ns());
+    pub.publish(e);
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  }
+  std::fprintf(stderr, "publish_gesture: published %d events\n", count);
+  return 0;
+}
