@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
   using namespace skelgraph;
   const double seconds = argc > 1 ? std::atof(argv[1]) : 10.0;
   auto config = runtime::DdsConfig::from_env();
+  config.profile = "loopback";  // tests only: 127.0.0.1 and shared memory
   runtime::Context ctx("publish_gesture", config);
   runtime::Publisher<msg::GestureEvent> pub(ctx, runtime::topics::kGestureEvent);
   msg::GestureEvent e;

@@ -8,10 +8,8 @@
 // its sensor's pose; one whose sensor has no pose yet is counted, not drawn.
 // Joints keep their tracking state: 2 tracked, 1 inferred, 0 lost (not drawn).
 
-#include <array>
 #include <cstdint>
 #include <map>
-#include <optional>
 #include <string>
 #include <tuple>
 #include <vector>
