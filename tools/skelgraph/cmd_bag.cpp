@@ -8,6 +8,7 @@
 #include <map>
 #include <memory>
 #include <set>
+#include <tuple>
 
 #include <nlohmann/json.hpp>
 
@@ -40,6 +41,26 @@ auto user_input(F&& f) {
   }
 }
 
+// Ticks acked per host: distinct ticks of the recording's sessions (the
+// sessions its sync topic names). An ack of the previous session's last tick
+// can arrive after the next session's file was opened; it is not counted.
+class AckTally {
+ public:
+  void ack(const msg::SyncAck& a) { acks_.insert({a.host().to_string(), a.session_id(), a.tick()}); }
+  void session(std::uint32_t id) { sessions_.insert(id); }
+  std::map<std::string, std::uint64_t> by_host() const {
+    std::map<std::string, std::uint64_t> out;
+    for (const auto& [host, session, tick] : acks_) {
+      if (sessions_.count(session)) ++out[host];
+    }
+    return out;
+  }
+
+ private:
+  std::set<std::tuple<std::string, std::uint32_t, std::uint64_t>> acks_;
+  std::set<std::uint32_t> sessions_;
+};
+
 int info(const std::string& file, bool json) {
   const mcap::Reader reader = user_input([&] { return mcap::Reader(file); });
   std::string problem;
@@ -52,13 +73,14 @@ int info(const std::string& file, bool json) {
   // Ticks and sessions from the sync topic.
   std::uint64_t ticks = 0;
   std::set<std::uint32_t> sessions;
-  std::map<std::string, std::uint64_t> per_sensor, acks_by_host, ticks_with;
+  std::map<std::string, std::uint64_t> per_sensor, ticks_with;
+  AckTally acks;
   std::uint64_t tick_records = 0;
   std::map<std::string, nlohmann::json> clocks;
   reader.for_each_message([&](const mcap::Channel& ch, const mcap::Schema* schema, const mcap::Message& m) {
     if (schema == nullptr) return;
     if (schema->name == msg::MessageTraits<msg::SyncAck>::name) {
-      ++acks_by_host[msg::from_cdr<msg::SyncAck>(m.data.data(), m.data.size()).host().to_string()];
+      acks.ack(msg::from_cdr<msg::SyncAck>(m.data.data(), m.data.size()));
     } else if (schema->name == msg::MessageTraits<msg::ClockOffset>::name) {
       const auto c = msg::from_cdr<msg::ClockOffset>(m.data.data(), m.data.size());
       clocks[c.host().to_string()] = nlohmann::json(c);
@@ -67,6 +89,7 @@ int info(const std::string& file, bool json) {
       const auto c = msg::from_cdr<msg::SyncCommand>(m.data.data(), m.data.size());
       if (c.kind() == msg::SYNC_TICK) ++ticks;
       sessions.insert(c.session_id());
+      acks.session(c.session_id());
     } else if (schema->name == msg::MessageTraits<msg::Skeleton>::name) {
       const auto k = msg::from_cdr<msg::Skeleton>(m.data.data(), m.data.size());
       ++per_sensor[ch.topic + " " + k.sensor_id().to_string()];
@@ -105,7 +128,7 @@ int info(const std::string& file, bool json) {
                            {"sessions", sessions},
                            {"topics", topics},
                            {"skeletons_per_sensor", per_sensor},
-                           {"ticks_acked_by_host", acks_by_host},
+                           {"ticks_acked_by_host", acks.by_host()},
                            {"tick_records", tick_records},
                            {"ticks_with_frames_of", ticks_with},
                            {"clock_offsets", clocks},
@@ -122,7 +145,7 @@ int info(const std::string& file, bool json) {
       std::printf("  %-32s %-34s %8llu msgs %8.2f Hz\n", t["topic"].get<std::string>().c_str(),
                   t["type"].get<std::string>().c_str(), t["count"].get<unsigned long long>(), t["rate_hz"].get<double>());
     }
-    for (const auto& [h, n] : acks_by_host) std::printf("  host %-20s %8llu ticks acked\n", h.c_str(), static_cast<unsigned long long>(n));
+    for (const auto& [h, n] : acks.by_host()) std::printf("  host %-20s %8llu ticks acked\n", h.c_str(), static_cast<unsigned long long>(n));
     for (const auto& [h, c] : clocks) {
       std::printf("  clock %-19s offset %+.3f ms, drift %+.1f ppm, rtt %.3f ms\n", h.c_str(),
                   c["offset_ns"].get<double>() * 1e-6, c["drift_ppm"].get<double>(), c["rtt_ns"].get<double>() * 1e-6);
@@ -282,7 +305,7 @@ int merge(const std::vector<std::string>& files, const std::string& out_path, mc
   std::map<std::pair<std::string, std::string>, std::size_t> seen;  // (topic, bytes) -> the input that had it
   std::uint64_t duplicates = 0;
   nlohmann::json applied = nlohmann::json::object();
-  std::map<std::string, std::uint64_t> acks_by_host;
+  AckTally acks;
   for (std::size_t i = 0; i < inputs.size(); ++i) {
     const auto it = clocks.find(inputs[i].host);
     const double offset = it == clocks.end() ? 0.0 : static_cast<double>(it->second.offset_ns());
@@ -303,7 +326,9 @@ int merge(const std::vector<std::string>& files, const std::string& out_path, mc
       const auto type = ch.metadata.count("dds_type") ? ch.metadata.at("dds_type") : std::string();
       const bool keyed = ch.metadata.count("keyed") && ch.metadata.at("keyed") == "true";
       if (ch.topic == runtime::topics::kSyncAck.name) {
-        ++acks_by_host[msg::from_cdr<msg::SyncAck>(m.data.data(), m.data.size()).host().to_string()];
+        acks.ack(msg::from_cdr<msg::SyncAck>(m.data.data(), m.data.size()));
+      } else if (ch.topic == runtime::topics::kSync.name) {
+        acks.session(msg::from_cdr<msg::SyncCommand>(m.data.data(), m.data.size()).session_id());
       }
       items.push_back(
           {static_cast<std::uint64_t>(std::max(0.0, corrected)), ch.topic, type, keyed, data, m.publish_time, i});
@@ -319,6 +344,7 @@ int merge(const std::vector<std::string>& files, const std::string& out_path, mc
     meta["offset_ns " + host] = std::to_string(c.offset_ns());
     meta["drift_ppm " + host] = std::to_string(c.drift_ppm());
   }
+  const auto acks_by_host = acks.by_host();
   for (const auto& [host, n] : acks_by_host) meta["ticks_acked " + host] = std::to_string(n);
   bag.write_metadata("merge", meta);
   recording::TickAssociator assoc(static_cast<std::int64_t>(max_age_ms * 1e6));
