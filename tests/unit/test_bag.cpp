@@ -6,10 +6,13 @@
 #include <filesystem>
 #include <map>
 
+#include <unistd.h>
+
 #include "skelgraph/mcap/mcap.hpp"
 #include "skelgraph/msg/cdr.hpp"
 #include "skelgraph/playback/readers.hpp"
 #include "skelgraph/recording/bag.hpp"
+#include "skelgraph/recording/session_recorder.hpp"
 #include "skelgraph/recording/tick_frames.hpp"
 #include "skelgraph/skeleton/skeleton_msg.hpp"
 
@@ -133,4 +136,27 @@ TEST(TickFrames, EachTickGetsTheLatestRecentFrameOfEveryStream) {
   a.frame(frame_ref("s1", 1, 14, 1'161'000'000));
   ASSERT_EQ(t.frames().size(), 1u);
   EXPECT_EQ(t.frames()[0].frame_number(), 13u);
+}
+
+TEST(SessionRecorder, ARestartedRecorderNeverOverwritesItsSessionFile) {
+  const auto dir = fs::temp_directory_path() / ("skelgraph_session_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  recording::RecorderOptions o;
+  o.directory = dir.string();
+  o.host = "sensor1";
+  std::string first;
+  {
+    recording::SessionRecorder a(o, "cell", 42, 1'000);
+    first = a.path();
+    a.record("skelgraph/sync", "skelgraph::msg::SyncCommand", false, "abcd", 2'000, 2'000);
+    a.finish(3'000);
+  }
+  const auto size = fs::file_size(first);
+  recording::SessionRecorder b(o, "cell", 42, 4'000);  // the same session again, as after a restart
+  EXPECT_EQ(fs::path(first).filename(), "cell_42_sensor1.mcap");
+  EXPECT_EQ(fs::path(b.path()).filename(), "cell_42_sensor1_2.mcap");
+  EXPECT_EQ(fs::file_size(first), size);  // untouched
+  recording::SessionRecorder c(o, "cell", 42, 5'000);
+  EXPECT_EQ(fs::path(c.path()).filename(), "cell_42_sensor1_3.mcap");
+  fs::remove_all(dir);
 }

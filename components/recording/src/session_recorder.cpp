@@ -22,7 +22,14 @@ SessionRecorder::SessionRecorder(const RecorderOptions& options, const std::stri
   std::error_code ec;
   std::filesystem::create_directories(opt_.directory, ec);
   if (ec) throw mcap::McapError("cannot create recording directory " + opt_.directory + ": " + ec.message());
-  path_ = (std::filesystem::path(opt_.directory) / file_name(label, session_id, opt_.host)).string();
+  // A recorder restarted within a session (its process, or its participant
+  // after a stuck authentication) goes on in a new file: never overwrite.
+  const std::filesystem::path dir(opt_.directory);
+  const std::string name = file_name(label, session_id, opt_.host);
+  path_ = (dir / name).string();
+  for (int k = 2; std::filesystem::exists(path_, ec); ++k) {
+    path_ = (dir / (name.substr(0, name.size() - 5) + "_" + std::to_string(k) + ".mcap")).string();
+  }
   mcap::WriterOptions wo;
   wo.compression = opt_.compression;
   wo.library = "skelgraph recorder";

@@ -34,6 +34,8 @@ class SessionRecorder {
   ~SessionRecorder();
 
   // File name: <label>_<session>_<host>.mcap, anything but [A-Za-z0-9._-] replaced by '_'.
+  // If that file exists (the recorder was restarted within the session), the
+  // new one is <label>_<session>_<host>_2.mcap, _3, ...: nothing is overwritten.
   static std::string file_name(const std::string& label, std::uint32_t session_id, const std::string& host);
 
   void record(const std::string& topic, const std::string& type_name, bool keyed, std::string_view cdr,
