@@ -44,6 +44,7 @@ try {
   out.drawn_per_s = (b.framesDrawn - a.framesDrawn) / dt;
   out.page_fps = b.fps;
   out.sensors = b.sensors;
+  out.streams = b.streams;  // what the viewer received: kind and rate per stream
   out.gl = b.gl;
   out.gestures = { events: b.gestures.length, drawn: b.drawnGestures,
                    text: await page.locator('#gestures').innerText() };

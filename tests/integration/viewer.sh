@@ -48,8 +48,11 @@ import json, sys
 work, tag, sensors = sys.argv[1], sys.argv[2], int(sys.argv[3])
 page = json.load(open(f"{work}/{tag}-page.json"))
 published = {}
+echoed = {}
 for t in ("raw", "fused", "truth"):
+    echoed[t] = 0
     for line in open(f"{work}/{tag}-{t}.jsonl"):
+        echoed[t] += 1
         s = json.loads(line)["data"]
         n = sum(1 for j in s["joints"] if j["confidence"] > 0)
         published[(s["sensor_id"], s["person_id"], s["frame_number"])] = n
@@ -78,7 +81,8 @@ for snap in page["snapshots"]:
 check(compared >= 40, f"only {compared} drawn skeletons found among the published ones ({missing} not found)")
 check(missing <= compared // 20, f"{missing} drawn skeletons not among the published ({compared} found)")
 expected = {f"sensor{i + 1}" for i in range(sensors)} | {"fused", "truth"}
-check(expected <= streams, f"streams drawn: {sorted(streams)}, expected {sorted(expected)}")
+check(expected <= streams, f"streams drawn: {sorted(streams)}, expected {sorted(expected)}; the viewer received "
+      f"{ {k: v['rate_hz'] for k, v in page['streams'].items()} } Hz; samples echoed by topic echo: {echoed}")
 t = page.get("toggle")
 check(t and t["after"] == t["before"] - 1 and not t["still_drawn"] and t["restored"], f"layer toggle: {t}")
 p = page["pause"]

@@ -285,6 +285,7 @@ function apply(frame) {
     const l = layer(name, `${name} (${st.kind})`, colourOf(name));
     l.rate.textContent = `${st.rate_hz.toFixed(1)} Hz${frame.unplaced.includes(name) ? ', no pose yet' : ''}`;
   }
+  stats.streams = frame.streams;
   stats.gestures = frame.gestures;
   stats.players = frame.players;
   drawGestures(frame.gestures);
