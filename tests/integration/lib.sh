@@ -1,7 +1,7 @@
 # Shared helpers for the integration scripts (sourced). They run inside
 # tests/netns-lo.sh, so every process here sees only the loopback interface.
 set -euo pipefail
-SKELGRAPH=${1:?usage: $0 path/to/skelgraph}
+SKELGRAPH=$(realpath "${1:?usage: $0 path/to/skelgraph}")  # absolute: some helpers run it from elsewhere
 SRC=${SKELGRAPH_SOURCE_DIR:?set by ctest}
 WORK=$(mktemp -d)
 trap 'kill $(jobs -p) 2>/dev/null || true; rm -rf "$WORK"' EXIT
@@ -35,6 +35,9 @@ wait_for_match() {
 # retry N CMD...: runs CMD until it succeeds, at most N times (each try is itself bounded).
 retry() {
   local n=$1; shift
-  for _ in $(seq "$n"); do "$@" && return 0; done
+  for k in $(seq "$n"); do
+    "$@" && return 0
+    echo "retry: attempt $k of $n failed: $*" >&2
+  done
   return 1
 }

@@ -5,13 +5,18 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <map>
+#include <mutex>
 #include <set>
+#include <sstream>
 #include <utility>
 #include <vector>
 #include <stdexcept>
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/domain/DomainParticipantListener.hpp>
+#include <fastrtps/config.h>
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
@@ -28,6 +33,97 @@
 namespace skelgraph::runtime {
 
 namespace dds = eprosima::fastdds::dds;
+namespace rtps = eprosima::fastrtps::rtps;
+
+// The listener of a secure participant: remembers each remote participant
+// that brought credentials (an identity token in its announcement) until it
+// is authenticated or refused, and passes discovery on to the caller's
+// listener. A refusal is printed (a stranger, or a certificate of another CA).
+class AuthWatch final : public dds::DomainParticipantListener {
+ public:
+  AuthWatch(std::string self, dds::DomainParticipantListener* next) : self_(std::move(self)), next_(next) {}
+
+  void on_participant_discovery(dds::DomainParticipant* p, rtps::ParticipantDiscoveryInfo&& info) override {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      const auto key = prefix(info.info.m_guid);
+      if (info.status == rtps::ParticipantDiscoveryInfo::DISCOVERED_PARTICIPANT) {
+        names_[key] = info.info.m_participantName.to_string();
+        if (!info.info.identity_token_.is_nil() && !done_.count(key)) {
+          pending_.emplace(key, Pending{names_[key], Context::monotonic_ns()});
+        }
+      } else if (info.status != rtps::ParticipantDiscoveryInfo::CHANGED_QOS_PARTICIPANT) {
+        const auto it = pending_.find(key);
+        if (it != pending_.end() && it->second.seen_stalled) stalled_before_.insert(identity(it->second.name, key));
+        if (it != pending_.end()) pending_.erase(it);
+        done_.erase(key);
+        names_.erase(key);
+      }
+    }
+    if (next_ != nullptr) next_->on_participant_discovery(p, std::move(info));
+  }
+
+  void onParticipantAuthentication(dds::DomainParticipant* p, rtps::ParticipantAuthenticationInfo&& info) override {
+    std::string name;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      const auto key = prefix(info.guid);
+      const auto n = names_.find(key);
+      name = n != names_.end() ? n->second : std::string("?");
+      pending_.erase(key);
+      done_.insert(key);
+    }
+    if (info.status == rtps::ParticipantAuthenticationInfo::UNAUTHORIZED_PARTICIPANT) {
+      std::fprintf(stderr, "%s: refused DDS participant '%s' (%s): it did not authenticate (no or other credentials)\n", self_.c_str(),
+                   name.c_str(), prefix(info.guid).c_str());
+    }
+    if (next_ != nullptr) next_->onParticipantAuthentication(p, std::move(info));
+  }
+
+  void on_publisher_discovery(dds::DomainParticipant* p, rtps::WriterDiscoveryInfo&& info) override {
+    if (next_ != nullptr) next_->on_publisher_discovery(p, std::move(info));
+  }
+  void on_subscriber_discovery(dds::DomainParticipant* p, rtps::ReaderDiscoveryInfo&& info) override {
+    if (next_ != nullptr) next_->on_subscriber_discovery(p, std::move(info));
+  }
+
+  std::vector<Context::Unauthenticated> stalled(std::int64_t older_than_ns) {
+    std::vector<Context::Unauthenticated> out;
+    const auto now = Context::monotonic_ns();
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (auto& [key, p] : pending_) {
+      if (now - p.since_ns <= older_than_ns) continue;
+      p.seen_stalled = true;
+      out.push_back({"'" + p.name + "' (" + key + ")", p.since_ns, stalled_before_.count(identity(p.name, key)) > 0});
+    }
+    return out;
+  }
+
+ private:
+  struct Pending {
+    std::string name;
+    std::int64_t since_ns;
+    bool seen_stalled = false;
+  };
+  // A component of a host, across its restarts: its participant name and the
+  // first 6 bytes of its GUID prefix (with DDS Security, derived from the
+  // host's certificate).
+  static std::string identity(const std::string& name, const std::string& prefix) {
+    return name + "@" + prefix.substr(0, 17);
+  }
+  static std::string prefix(const rtps::GUID_t& g) {
+    std::ostringstream os;
+    os << g.guidPrefix;
+    return os.str();
+  }
+  std::string self_;
+  dds::DomainParticipantListener* next_;
+  mutable std::mutex mutex_;
+  std::map<std::string, Pending> pending_;
+  std::set<std::string> done_;
+  std::map<std::string, std::string> names_;  // guid prefix -> participant name, of every participant known
+  std::set<std::string> stalled_before_;      // identities that stalled with us and then went away
+};
 
 namespace {
 
@@ -134,8 +230,9 @@ Context::Context(std::string name, const DdsConfig& config, dds::DomainParticipa
                              "SKELGRAPH_DISCOVERY_SERVERS (start one with `fastdds discovery -i 0 -l IP -p PORT`)");
   }
   const bool secure = apply_security(qos, config, profile);
-  participant_ = factory->create_participant(static_cast<dds::DomainId_t>(config.domain), qos, listener,
-                                             dds::StatusMask::none());
+  if (secure) auth_watch_ = std::make_unique<AuthWatch>(name_, listener);
+  participant_ = factory->create_participant(static_cast<dds::DomainId_t>(config.domain), qos,
+                                             secure ? auth_watch_.get() : listener, dds::StatusMask::none());
   if (participant_ == nullptr) {
     throw std::runtime_error(
         "component '" + name_ + "': could not create a DDS participant on domain " + std::to_string(config.domain) +
@@ -166,6 +263,11 @@ std::int64_t Context::now_ns() {
              std::chrono::system_clock::now().time_since_epoch())
              .count() +
          skew;
+}
+
+std::vector<Context::Unauthenticated> Context::unauthenticated(std::chrono::milliseconds after) {
+  if (!auth_watch_) return {};
+  return auth_watch_->stalled(std::chrono::duration_cast<std::chrono::nanoseconds>(after).count());
 }
 
 std::int64_t Context::monotonic_ns() {

@@ -1,6 +1,9 @@
 #include "skelgraph/runtime/graph.hpp"
 
+#include <cstdio>
+#include <cstdlib>
 #include <map>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -22,12 +25,33 @@ msg::ComponentState to_msg(HealthState s) {
   return msg::STATE_ERROR;
 }
 const char* to_text(HealthState s) { return msg::to_string(to_msg(s)); }
+constexpr std::chrono::milliseconds kAuthStall{10000};
+
+// SKELGRAPH_TEST_AUTH_STALL=NAME@SECONDS: a test hook (like
+// SKELGRAPH_CLOCK_SKEW_NS) that makes heal() treat component NAME as stuck in
+// authentication SECONDS after its start, once, so the restart can be tested
+// without a secure cell that happens to hit the Fast DDS defect.
+std::pair<std::string, std::int64_t> test_stall() {
+  static const auto v = [] {
+    const char* e = std::getenv("SKELGRAPH_TEST_AUTH_STALL");
+    if (e == nullptr) return std::pair<std::string, std::int64_t>{};
+    const std::string s(e);
+    const auto at = s.find('@');
+    const double secs = at == std::string::npos ? 20.0 : std::atof(s.c_str() + at + 1);
+    return std::pair<std::string, std::int64_t>{s.substr(0, at), static_cast<std::int64_t>(secs * 1e9)};
+  }();
+  return v;
+}
 }  // namespace
 
 // Members are destroyed bottom-up: the component first, then the status
 // writer, then the context (participant) — the reverse of creation.
 struct Graph::Node {
+  std::string name;
   std::string kind;
+  Params params;
+  std::int64_t created_ns = 0;   // monotonic: when the context (participant) was made
+  int restarts = 0;
   std::unique_ptr<Context> context;
   std::unique_ptr<Publisher<msg::ComponentStatus>> status;
   std::unique_ptr<Component> component;
@@ -35,7 +59,15 @@ struct Graph::Node {
   std::map<std::string, std::uint64_t> last_counts;  // executor thread only
   std::int64_t last_report_ns = 0;
 
+  std::set<std::string> stalls_reported;  // executor thread only
+
   void publish_status() {
+    for (const auto& p : context->unauthenticated(kAuthStall)) {
+      if (stalls_reported.insert(p.who).second) {
+        std::fprintf(stderr, "%s: DDS participant %s has not finished authenticating after %lld s\n",
+                     context->name().c_str(), p.who.c_str(), static_cast<long long>(kAuthStall.count() / 1000));
+      }
+    }
     msg::ComponentStatus s;
     s.component_name(context->name());
     s.kind(kind);
@@ -81,16 +113,79 @@ Component& Graph::add(const std::string& name, const std::string& kind, const Pa
   const auto* entry = registry_.find(kind);
   if (entry == nullptr) throw std::runtime_error("component '" + name + "': unknown type '" + kind + "'");
   auto node = std::make_unique<Node>();
+  node->name = name;
   node->kind = kind;
-  node->context = std::make_unique<Context>(name, config_);
-  node->status = std::make_unique<Publisher<msg::ComponentStatus>>(*node->context, topics::kStatus);
-  try {
-    node->component = entry->factory(*node->context, params);
-  } catch (const std::exception& e) {
-    throw std::runtime_error("component '" + name + "' (" + kind + "): " + e.what());
-  }
+  node->params = params;
+  build(*node);
   nodes_.push_back(std::move(node));
   return *nodes_.back()->component;
+}
+
+void Graph::build(Node& node) {
+  node.context = std::make_unique<Context>(node.name, config_);
+  node.created_ns = Context::monotonic_ns();
+  node.status = std::make_unique<Publisher<msg::ComponentStatus>>(*node.context, topics::kStatus);
+  try {
+    node.component = registry_.find(node.kind)->factory(*node.context, node.params);
+  } catch (const std::exception& e) {
+    throw std::runtime_error("component '" + node.name + "' (" + node.kind + "): " + e.what());
+  }
+}
+
+void Graph::start_node(Node* node) {
+  node->context->executor().start();
+  node->context->executor().post([node] { node->component->on_start(); });
+  node->status_timer = node->context->executor().every(status_period_, [node] { node->publish_status(); });
+}
+
+void Graph::shut_down(Node* node) {
+  node->context->executor().run_sync(
+      [node] {
+        node->status_timer.cancel();
+        node->component->on_shutdown();
+      },
+      std::chrono::seconds(5));
+}
+
+std::vector<std::string> Graph::heal(std::chrono::milliseconds stall, int max_restarts) {
+  std::vector<std::string> restarted;
+  if (!started_ || stopped_) return restarted;
+  const auto stall_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(stall).count();
+  for (auto& n : nodes_) {
+    Node* node = n.get();
+    if (node->restarts >= max_restarts) continue;
+    // Peers met at this participant's start: the newcomer is the one to start
+    // over (a stuck newcomer elsewhere restarts itself), so a stranger or a
+    // tool joining later does not restart a running component; unless the
+    // peer did start over and is stuck with us again: then the fault is on
+    // our side.
+    std::vector<std::string> stuck;
+    for (const auto& p : node->context->unauthenticated(stall)) {
+      if (p.since_ns - node->created_ns <= stall_ns / 2 || p.again) stuck.push_back(p.who);
+    }
+    if (const auto fake = test_stall(); node->restarts == 0 && fake.first == node->name &&
+                                        Context::monotonic_ns() - node->created_ns > fake.second) {
+      stuck.push_back("'test' (SKELGRAPH_TEST_AUTH_STALL)");
+    }
+    if (stuck.empty()) continue;
+    std::string who;
+    for (const auto& w : stuck) who += (who.empty() ? "" : ", ") + w;
+    std::fprintf(stderr,
+                 "%s: restarting it with a new DDS participant: %s never finished authenticating with it "
+                 "(Fast DDS 2.9 leaves such a pair for good; docs/security.md)\n",
+                 node->name.c_str(), who.c_str());
+    shut_down(node);
+    node->context->flush(std::chrono::milliseconds(500));
+    node->context->executor().stop();
+    node->component.reset();
+    node->status.reset();
+    node->context.reset();
+    build(*node);
+    ++node->restarts;
+    start_node(node);
+    restarted.push_back(node->name);
+  }
+  return restarted;
 }
 
 bool Graph::finished() const {
@@ -110,12 +205,7 @@ void Graph::add_all(const std::vector<ResolvedComponent>& components) {
 void Graph::start() {
   if (started_) return;
   started_ = true;
-  for (auto& n : nodes_) {
-    Node* node = n.get();
-    node->context->executor().start();
-    node->context->executor().post([node] { node->component->on_start(); });
-    node->status_timer = node->context->executor().every(status_period_, [node] { node->publish_status(); });
-  }
+  for (auto& n : nodes_) start_node(n.get());
 }
 
 void Graph::stop() {
@@ -124,15 +214,7 @@ void Graph::stop() {
   // 1. Every component's last words (a STOP, say) while all still listen;
   // 2. wait until reliable readers have them; 3. stop the executors, which
   // first run what is already queued.
-  for (auto it = nodes_.rbegin(); it != nodes_.rend(); ++it) {
-    Node* node = it->get();
-    node->context->executor().run_sync(
-        [node] {
-          node->status_timer.cancel();
-          node->component->on_shutdown();
-        },
-        std::chrono::seconds(5));
-  }
+  for (auto it = nodes_.rbegin(); it != nodes_.rend(); ++it) shut_down(it->get());
   for (auto& n : nodes_) n->context->flush(std::chrono::milliseconds(1000));
   for (auto it = nodes_.rbegin(); it != nodes_.rend(); ++it) (*it)->context->executor().stop();
 }

@@ -48,6 +48,8 @@ struct EndpointCounter {
 
 enum class HealthState { Ok, Degraded, Error };
 
+class AuthWatch;  // context.cpp: which secure participants have authenticated
+
 class Context {
  public:
   // Throws std::runtime_error with the profile and domain if DDS refuses.
@@ -85,6 +87,17 @@ class Context {
   bool flush(std::chrono::milliseconds timeout);
   std::vector<std::shared_ptr<EndpointCounter>> counters() const;
 
+  // With a secure profile: the remote participants (with credentials) this
+  // one has known for longer than `after` without either side finishing the
+  // authentication handshake, as "name (guid prefix)". Fast DDS 2.9 leaves
+  // such a pair for good (docs/security.md); empty without security.
+  struct Unauthenticated {
+    std::string who;        // "name (guid prefix)"
+    std::int64_t since_ns;  // monotonic: when it was discovered
+    bool again = false;     // the same component of the same host was stuck with us before, and restarted
+  };
+  std::vector<Unauthenticated> unauthenticated(std::chrono::milliseconds after);
+
   // The component's health, reported on skelgraph/status.
   void set_health(HealthState state, std::string message);
   std::pair<HealthState, std::string> health() const;
@@ -92,6 +105,7 @@ class Context {
  private:
   std::string name_;
   DdsConfig config_;
+  std::unique_ptr<AuthWatch> auth_watch_;  // the participant's listener when secure: outlives it
   eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
   eprosima::fastdds::dds::Publisher* publisher_ = nullptr;
   eprosima::fastdds::dds::Subscriber* subscriber_ = nullptr;

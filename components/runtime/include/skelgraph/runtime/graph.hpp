@@ -45,6 +45,14 @@ class Graph {
   void start();  // starts every executor, then on_start() of each component
   void stop();   // on_shutdown() of each (reverse order), then stops executors; idempotent
 
+  // Secure profiles: a component whose participant met a peer at its start
+  // that has not finished authenticating after `stall` (a handshake takes
+  // 1-2 s) is started over with a
+  // new participant (at most `max_restarts` times each), since Fast DDS 2.9
+  // never retries such a pair. Returns the components restarted. Call from
+  // the thread that owns the graph, after start().
+  std::vector<std::string> heal(std::chrono::milliseconds stall = std::chrono::seconds(10), int max_restarts = 3);
+
   // True when the graph has components with an end and all of them have finished.
   bool finished() const;
 
@@ -54,6 +62,9 @@ class Graph {
 
  private:
   struct Node;
+  void build(Node& node);  // context, status writer and component, from the node's name, kind and params
+  void start_node(Node* node);
+  void shut_down(Node* node);  // on_shutdown() on the node's executor
   const ComponentRegistry& registry_;
   DdsConfig config_;
   std::chrono::milliseconds status_period_;
