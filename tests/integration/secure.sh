@@ -33,20 +33,28 @@ for h in fusion sensor1 sensor2; do
   eval "p_$h=\$SPAWNED"
   sleep 1
 done
+cell_started=$SECONDS
 
 # A new secure participant (each command-line tool run is one) sometimes does not
 # match the cell within 30 s, and the next one does within 1-2 s (Fast DDS 2.9's
 # authentication; measured and reported in docs/security.md): tools here get 3 tries.
 # 1. The cell, authenticated and encrypted, end to end.
-rate() { sg fusion topic hz skelgraph/skeleton/fused --window 3 --json --timeout 15 >"$WORK/hz_$1.json" 2>"$WORK/hz_$1.err" &&
-  json_get "$WORK/hz_$1.json" 'round(d["rate_hz"], 1)'; }
-r=$(retry 3 rate secure) || fail "no fused skeletons on the secure cell: $(tail -3 "$WORK"/*.err)"
-python3 -c "import sys; sys.exit(0 if 27 <= float(sys.argv[1]) <= 33 else 1)" "$r" || fail "fused rate: $r Hz"
+# The rate: best of up to 3 windows of 3 s (the fusion host trains its gesture model at
+# start, on the same 2 cores: a first window read 24.5 Hz once).
+rate() { sg fusion topic hz skelgraph/skeleton/fused --window 3 --json --timeout 15 >"$WORK/hz.json" 2>"$WORK/hz.err" &&
+  json_get "$WORK/hz.json" 'round(d["rate_hz"], 1)' | tee -a "$WORK/rates.txt" |
+  python3 -c "import sys; sys.exit(0 if 27 <= float(sys.stdin.read()) <= 33 else 1)"; }
+retry 3 rate || fail "fused rate on the secure cell not 27-33 Hz in 3 windows: $(cat "$WORK/rates.txt" 2>/dev/null) $(cat "$WORK/hz.err")"
+r=$(tail -1 "$WORK/rates.txt")
 retry 3 sg fusion topic echo skelgraph/skeleton/fused --json --count 20 --timeout 10 >"$WORK/fused.jsonl"
 python3 -c '
 import json, sys
 masks = [max(j["sensor_mask"] for j in json.loads(l)["data"]["joints"]) for l in open(sys.argv[1])]
 sys.exit(0 if max(masks) == 3 else 1)' "$WORK/fused.jsonl" || fail "fused joints not from both sensor hosts"
+# A component whose participant is stuck in authentication is started over by
+# launch 10 s after its start (docs/security.md): the session starts once that
+# is behind us, so every host records all of it.
+while [ $((SECONDS - cell_started)) -lt 15 ]; do sleep 1; done
 retry 3 sg fusion sync start --label secure --timeout 10 >/dev/null || fail "sync start on the secure cell"
 ok "secure cell: fused $r Hz from both authenticated sensor hosts; sync session started by the master host"
 
