@@ -36,8 +36,18 @@ sys.exit(1)' "$1" >"$WORK/status_$1.json" && return 0
   done
   return 1
 }
-# rate: the fused output's rate over 3 s.
-rate() { "$SKELGRAPH" topic hz skelgraph/skeleton/fused --window 3 --json --timeout 10 >"$WORK/hz_$1.json" && json_get "$WORK/hz_$1.json" 'round(d["rate_hz"], 1)'; }
+# rate: the fused output's rate over 3 s; up to three windows until one is
+# 27-33 Hz (the simulated trackers lose the walking person for about half a
+# second when the walk starts over: a clean-clone run read 24.3 Hz once).
+rate() {
+  local r=0
+  for i in 1 2 3; do
+    "$SKELGRAPH" topic hz skelgraph/skeleton/fused --window 3 --json --timeout 10 >"$WORK/hz_$1_$i.json" || return 1
+    r=$(json_get "$WORK/hz_$1_$i.json" 'round(d["rate_hz"], 1)')
+    python3 -c "import sys; sys.exit(0 if 27 <= float(sys.argv[1]) <= 33 else 1)" "$r" && break
+  done
+  echo "$r"
+}
 
 status OK || fail "fusion never OK: $(tail -5 "$WORK/fusion.err")"
 timeout 10 "$SKELGRAPH" topic echo skelgraph/skeleton/fused --json --count 30 --timeout 5 >"$WORK/fused.jsonl"

@@ -151,8 +151,9 @@ std::vector<std::string> Graph::heal(std::chrono::milliseconds stall, int max_re
   std::vector<std::string> restarted;
   if (!started_ || stopped_) return restarted;
   const auto stall_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(stall).count();
-  for (auto& n : nodes_) {
-    Node* node = n.get();
+  for (auto it = nodes_.begin(); it != nodes_.end();) {
+    Node* node = it->get();
+    ++it;
     if (node->restarts >= max_restarts) continue;
     // Peers met at this participant's start: the newcomer is the one to start
     // over (a stuck newcomer elsewhere restarts itself), so a stranger or a
@@ -180,8 +181,16 @@ std::vector<std::string> Graph::heal(std::chrono::milliseconds stall, int max_re
     node->component.reset();
     node->status.reset();
     node->context.reset();
-    build(*node);
     ++node->restarts;
+    try {
+      build(*node);
+    } catch (const std::exception& e) {
+      // Gone from this launch; the final report names it (state ERROR).
+      std::fprintf(stderr, "%s: could not be started again: %s\n", node->name.c_str(), e.what());
+      lost_.push_back({node->name, node->kind, "ERROR", std::string("could not be started again: ") + e.what(), {}, {}, nullptr});
+      it = nodes_.erase(it - 1);
+      continue;
+    }
     start_node(node);
     restarted.push_back(node->name);
   }
@@ -220,7 +229,7 @@ void Graph::stop() {
 }
 
 std::vector<NodeReport> Graph::report() const {
-  std::vector<NodeReport> out;
+  std::vector<NodeReport> out(lost_);
   for (const auto& n : nodes_) {
     NodeReport r;
     r.name = n->context->name();

@@ -69,6 +69,7 @@ class Graph {
   DdsConfig config_;
   std::chrono::milliseconds status_period_;
   std::vector<std::unique_ptr<Node>> nodes_;
+  std::vector<NodeReport> lost_;  // components a restart could not bring back
   bool started_ = false;
   bool stopped_ = false;
 };
