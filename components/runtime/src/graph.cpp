@@ -25,7 +25,6 @@ msg::ComponentState to_msg(HealthState s) {
   return msg::STATE_ERROR;
 }
 const char* to_text(HealthState s) { return msg::to_string(to_msg(s)); }
-constexpr std::chrono::milliseconds kAuthStall{10000};
 
 // SKELGRAPH_TEST_AUTH_STALL=NAME@SECONDS: a test hook (like
 // SKELGRAPH_CLOCK_SKEW_NS) that makes heal() treat component NAME as stuck in
@@ -62,10 +61,10 @@ struct Graph::Node {
   std::set<std::string> stalls_reported;  // executor thread only
 
   void publish_status() {
-    for (const auto& p : context->unauthenticated(kAuthStall)) {
+    for (const auto& p : context->unauthenticated(Graph::kAuthStall)) {
       if (stalls_reported.insert(p.who).second) {
         std::fprintf(stderr, "%s: DDS participant %s has not finished authenticating after %lld s\n",
-                     context->name().c_str(), p.who.c_str(), static_cast<long long>(kAuthStall.count() / 1000));
+                     context->name().c_str(), p.who.c_str(), static_cast<long long>(Graph::kAuthStall.count() / 1000));
       }
     }
     msg::ComponentStatus s;

@@ -45,13 +45,17 @@ class Graph {
   void start();  // starts every executor, then on_start() of each component
   void stop();   // on_shutdown() of each (reverse order), then stops executors; idempotent
 
-  // Secure profiles: a component whose participant met a peer at its start
-  // that has not finished authenticating after `stall` (a handshake takes
-  // 1-2 s) is started over with a
-  // new participant (at most `max_restarts` times each), since Fast DDS 2.9
-  // never retries such a pair. Returns the components restarted. Call from
-  // the thread that owns the graph, after start().
-  std::vector<std::string> heal(std::chrono::milliseconds stall = std::chrono::seconds(10), int max_restarts = 3);
+  // A secure peer not authenticated after this long is stuck (a handshake takes 1-2 s).
+  static constexpr std::chrono::milliseconds kAuthStall{10000};
+
+  // Secure profiles: a component whose participant has a peer stuck in
+  // authentication for `stall` is started over with a new participant, since
+  // Fast DDS 2.9 never retries such a pair: when it met that peer at its own
+  // start (the newcomer restarts), or when the same component of the same
+  // host is stuck with it again after restarting. At most `max_restarts`
+  // times each. Returns the components restarted. Call from the thread that
+  // owns the graph, after start().
+  std::vector<std::string> heal(std::chrono::milliseconds stall = kAuthStall, int max_restarts = 3);
 
   // True when the graph has components with an end and all of them have finished.
   bool finished() const;
