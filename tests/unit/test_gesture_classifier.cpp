@@ -12,6 +12,7 @@
 
 #include "skelgraph/gesture/classifier.hpp"
 #include "skelgraph/gesture/dataset.hpp"
+#include "skelgraph/gesture/spotter.hpp"
 
 using namespace skelgraph::gesture;
 namespace fs = std::filesystem;
@@ -226,6 +227,78 @@ TEST(Classifier, CrossValidationAndRejection) {
   }
 }
 
+// Two classes that differ only in order: the right arm goes A then B, or B then A.
+// One state sees the same frames in both; two states see the order.
+TEST(Classifier, NestedCrossValidationChoosesInsideEachFold) {
+  ClassMap map;
+  map.classes = {"ab", "ba"};
+  map.action_class = {{"ab", "ab"}, {"ba", "ba"}};
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> n(0, 0.05);
+  std::vector<Clip> clips;
+  for (int k = 0; k < 2; ++k)
+    for (int i = 0; i < 10; ++i) {
+      Clip c;
+      c.action = map.classes[static_cast<std::size_t>(k)];
+      c.label = k;
+      c.subject = "s" + std::to_string(i % 5);
+      c.x = Sequence(60, 8);
+      for (Eigen::Index t = 0; t < 60; ++t) {
+        const bool first = (t < 30) == (k == 0);
+        for (int j = 0; j < 8; ++j) c.x(t, j) = n(rng);
+        c.x(t, 2) += first ? 1.0 : 2.0;
+        c.x(t, 3) += first ? 2.0 : 1.0;
+      }
+      clips.push_back(std::move(c));
+    }
+  std::vector<ClassifierOptions> configs(2, small_options());
+  for (auto& c : configs) c.hands = Hands::AsIs;
+  configs[0].hmm.states = 1;
+  configs[1].hmm.states = 2;
+  CvOptions cv;  // leave-subject-out: 5 outer folds, 4 inner
+  const auto one_state = evaluate(cross_validate(clips, map, configs[0], cv), map.classes);
+  EXPECT_LE(one_state.accuracy, 0.75);
+  int calls = 0;
+  const auto nested = nested_cross_validate(clips, map, configs, cv, [&](int, int total) {
+    ++calls;
+    EXPECT_EQ(total, 5);
+  });
+  EXPECT_EQ(calls, 5);
+  ASSERT_EQ(nested.results.size(), clips.size());
+  EXPECT_EQ(nested.chosen, std::vector<int>(5, 1));
+  EXPECT_GE(evaluate(nested.results, map.classes).accuracy, 0.95);
+  EXPECT_THROW(nested_cross_validate(clips, map, {}, cv), ModelError);
+}
+
+TEST(Classifier, HandFeaturesNeedWristsAndStayOffline) {
+  skelgraph::playback::Recording rec;
+  rec.format = "generic";
+  rec.source = "walk.csv";
+  rec.frames.resize(3);
+  FeatureOptions f;
+  f.set = FeatureSet::Hands;
+  const auto e = error_of([&] { recording_features(rec, f); });
+  EXPECT_NE(e.find("walk.csv: the 'hands' features need wrist joints; this generic recording has none"), std::string::npos) << e;
+  rec.extra_joints["left_wrist"].assign(3, Eigen::Vector3d::Zero());
+  rec.extra_joints["right_wrist"].assign(3, Eigen::Vector3d::Zero());
+  EXPECT_EQ(recording_features(rec, f).x.cols(), 12);
+  // A model on hand features cannot spot live: the skeleton topics carry no wrists.
+  auto o = small_options();
+  o.features.set = FeatureSet::Hands;
+  o.hands = Hands::AsIs;
+  std::vector<Clip> clips = synthetic_clips(4, 3, false);
+  for (auto& c : clips) {
+    Sequence x = Sequence::Zero(c.x.rows(), 12);
+    x.leftCols(4) = c.x.leftCols(4);
+    x.rightCols(4) = c.x.rightCols(4);
+    x.middleCols(4, 4).setRandom();
+    c.x = x;
+  }
+  const auto model = Classifier::train(clips, three_classes(), o);
+  const auto why = error_of([&] { Spotter s(model, {}); });
+  EXPECT_NE(why.find("need wrist joints; live skeletons carry none"), std::string::npos) << why;
+}
+
 TEST(Metrics, MatchHandCountedValues) {
   // Truth/prediction pairs: (0,0) (0,1) (1,1) (1,1) (1,0), and one clip in no class.
   const auto r = [](int truth, int label, double s0, double s1, bool rejected) {
@@ -323,4 +396,26 @@ TEST(KinderGator, LeaveSubjectOutTwoClass) {
   EXPECT_EQ(n, 160);
   EXPECT_GE(m.accuracy, 0.93);
   EXPECT_GE(m.recall[0], 0.6);
+}
+
+// With the hand segment (Kinect v1's wrist and hand), pointing is told apart
+// from signal-to-stop and push-a-button. 3 states, 2 mixtures, diagonal: the
+// winner of `gesture cv --features hands --sweep --sweep-mixtures 1 2`.
+TEST(KinderGator, LeaveSubjectOutTwoClassWithHands) {
+  const auto dir = kinder_gator();
+  ASSERT_TRUE(fs::is_directory(dir)) << dir << " is missing: tests read ../shared/data (or SKELGRAPH_DATA_DIR)";
+  const auto map = ClassMap::preset("two-class");
+  DatasetOptions d;
+  d.features.set = FeatureSet::Hands;
+  const auto clips = load_clips({dir}, map, d);
+  ASSERT_EQ(clips.size(), 160u);
+  auto o = ClassifierOptions{};
+  o.features = d.features;
+  o.calibration_folds = 0;
+  o.hmm.states = 3;
+  o.hmm.mixtures = 2;
+  o.hmm.covariance = Covariance::Diagonal;
+  const auto m = evaluate(cross_validate(clips, map, o, {}), map.classes);
+  EXPECT_GE(m.accuracy, 0.98);
+  EXPECT_GE(m.f1[0], 0.9);
 }

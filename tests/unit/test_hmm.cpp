@@ -308,3 +308,34 @@ TEST(Features, MissingJointsAreHeldAndMarked) {
   EXPECT_NEAR(g.x(0, 7), 0.0, 1e-9);   // right hand height in upper-arm lengths
   EXPECT_NEAR(g.x(0, 5), -2.0, 1e-9);  // left hand 0.6 m below the shoulder, upper arm 0.3 m
 }
+
+TEST(Features, HandsUseTheWristsWhenGiven) {
+  const auto names = feature_names(FeatureSet::Hands);
+  ASSERT_EQ(names.size(), 12u);  // thesis8's 4 angles, 2 hand values per arm, the 4 angles' speeds
+  EXPECT_EQ(names[2], "right_upper_arm_angle");
+  EXPECT_EQ(names[4], "left_hand_angle");
+  EXPECT_EQ(names[7], "right_hand_length");
+  EXPECT_EQ(names[11], "right_forearm_angle_speed");
+  EXPECT_TRUE(needs_wrists(FeatureSet::Hands));
+  EXPECT_FALSE(needs_wrists(FeatureSet::Extended));
+  // Right arm forward with the palm raised (the hand segment points up), left arm hanging.
+  const Eigen::Vector3d e(-0.2, 1.4, 1.7), h(-0.2, 1.5, 1.45);
+  Wrists w;
+  w.right = {-0.2, 1.4, 1.45};  // forearm 0.25 m, hand segment 0.1 m straight up
+  w.left = {0.2, 0.95, 2};      // forearm 0.15 m, hand segment 0.15 m down
+  FeatureOptions o;
+  o.set = FeatureSet::Hands;
+  const std::vector<Wrists> wrists{w};
+  const auto f = features_of({pose(e, h, 0)}, o, &wrists);
+  EXPECT_EQ(f.complete, std::vector<bool>{true});
+  EXPECT_NEAR(f.x(0, 4), M_PI, 1e-9);   // left hand segment down
+  EXPECT_NEAR(f.x(0, 5), 1.0, 1e-9);    // as long as the left forearm
+  EXPECT_NEAR(f.x(0, 6), 0.0, 1e-9);    // right hand segment straight up
+  EXPECT_NEAR(f.x(0, 7), 0.4, 1e-9);    // 0.1 / 0.25
+  EXPECT_NEAR(f.x(0, 2), M_PI / 2, 1e-9);  // the thesis angles as in thesis8
+  // Without wrists the hand values are missing: held (0 before any) and the frame incomplete.
+  const auto g = features_of({pose(e, h, 0)}, o);
+  EXPECT_EQ(g.complete, std::vector<bool>{false});
+  EXPECT_EQ(g.x(0, 6), 0.0);
+  EXPECT_THROW(features_of({pose(e, h, 0), pose(e, h, 1)}, o, &wrists), std::invalid_argument);  // one wrist per frame
+}

@@ -80,6 +80,12 @@ TEST(Readers, KinderGatorMapsJointsAndKeepsLabels) {
   const std::int64_t day_ns = 1469145600000LL * 1000000LL;
   EXPECT_EQ(rec.frames[0].stamp_ns, day_ns + 48000000500000LL);
   EXPECT_EQ(rec.frames[1].stamp_ns - rec.frames[0].stamp_ns, 32750000);
+  // The wrists (joints 6 and 10) are not canonical joints: one per frame in extra_joints.
+  ASSERT_EQ(rec.extra_joints.size(), 2u);
+  ASSERT_EQ(rec.extra_joints.at("left_wrist").size(), 2u);
+  ASSERT_EQ(rec.extra_joints.at("right_wrist").size(), 2u);
+  EXPECT_TRUE(rec.extra_joints.at("left_wrist")[1].isApprox(Eigen::Vector3d(0.06, 0.16, 0.26)));
+  EXPECT_TRUE(rec.extra_joints.at("right_wrist")[0].isApprox(Eigen::Vector3d(0.10, 0.20, 0.30)));
 }
 
 TEST(Readers, BadLinesNameFileLineAndExpectation) {
@@ -118,6 +124,8 @@ TEST(Readers, SkipPolicyKeepsGoodLinesAndReportsBadOnes) {
   opt.on_error = ReadOptions::OnError::Skip;
   const auto rec = read_recording(Format::KinderGator, path, opt);
   ASSERT_EQ(rec.frames.size(), 4u);  // 1, 3, 4, 4
+  EXPECT_EQ(rec.extra_joints.at("left_wrist").size(), 4u);  // a skipped line leaves no wrist behind
+  EXPECT_EQ(rec.extra_joints.at("right_wrist").size(), 4u);
   EXPECT_EQ(rec.report.lines, 7u);
   EXPECT_EQ(rec.report.skipped, 3u);  // bad number, short line, time backwards
   EXPECT_EQ(rec.report.repeated_stamps, 1u);
@@ -144,6 +152,9 @@ TEST(Readers, KinectV2TrackingStatesBecomeConfidence) {
   EXPECT_DOUBLE_EQ(s[JointId::Neck].position.x(), 2.0);  // SpineShoulder = 20
   EXPECT_DOUBLE_EQ(s[JointId::Torso].position.x(), 0.1);  // SpineMid = 1
   EXPECT_EQ(rec.frames[1].stamp_ns - rec.frames[0].stamp_ns, 33333300);
+  // Wrists (WristLeft = 6, WristRight = 10), both tracked here.
+  EXPECT_DOUBLE_EQ(rec.extra_joints.at("left_wrist")[0].x(), 0.6);
+  EXPECT_DOUBLE_EQ(rec.extra_joints.at("right_wrist")[1].y(), 1.1);
 
   const auto bad = write_file("v2_bad.csv", "5" + std::string(",0,0,0,3") + std::string(24 * 8, ' ') + "\n");
   EXPECT_THROW(read_recording(Format::KinectV2, bad), DataError);
@@ -317,6 +328,10 @@ TEST(Readers, MultiTrackTwoSensorsPeopleAndMissingJoints) {
   EXPECT_EQ(rec.frames[1][JointId::Neck].confidence, skeleton::kLost);  // exact zeros mean missing
   EXPECT_EQ(rec.frames[1][JointId::Head].confidence, skeleton::kTracked);
   EXPECT_EQ(rec.metadata.at("scenarios"), "6");
+  EXPECT_DOUBLE_EQ(rec.extra_joints.at("left_wrist")[0].x(), 23.0);  // WristLeft is alphabetical joint 23
+  EXPECT_DOUBLE_EQ(rec.extra_joints.at("right_wrist")[2].x(), 24.0);
+  const auto no_wrist = read_recording(Format::MultiTrack, write_file("mt_wrist.csv", mt_header() + mt_row(t0, 0, "1.2.3.4", 23)));
+  EXPECT_TRUE(no_wrist.extra_joints.at("left_wrist")[0].array().isNaN().all());  // missing: NaN
 
   std::string bad_header = mt_header();
   bad_header.replace(bad_header.find("Head_X"), 6, "Hand_X");
@@ -341,6 +356,8 @@ TEST(Readers, GesturePhasePackedClockBomCrlfAndLabels) {
   EXPECT_DOUBLE_EQ(rec.frames[0][JointId::Head].position.y(), -0.9);  // y flipped to point up
   EXPECT_DOUBLE_EQ(rec.frames[0][JointId::LeftHand].position.x(), 1.0);
   EXPECT_EQ(rec.frames[0][JointId::LeftElbow].confidence, skeleton::kLost);  // not in the format
+  EXPECT_DOUBLE_EQ(rec.extra_joints.at("left_wrist")[0].x(), 1.9);
+  EXPECT_DOUBLE_EQ(rec.extra_joints.at("right_wrist")[0].y(), -4.2);  // flipped too
 
   EXPECT_THROW(read_recording(Format::GesturePhase, write_file("gp_bad.csv", header + pos + ",4175973,Rest\r\n")),
                DataError);  // 41:75.973 is no clock reading

@@ -10,6 +10,7 @@
 #include <set>
 #include <sstream>
 #include <thread>
+#include <tuple>
 
 #include <yaml-cpp/yaml.h>
 
@@ -378,8 +379,10 @@ Classifier Classifier::load(const std::string& path) {
 
 // --- Cross-validation ---
 
-std::vector<ClipResult> cross_validate(const std::vector<Clip>& clips, const ClassMap& map, const ClassifierOptions& o,
-                                       const CvOptions& cv, const std::function<void(int, int)>& progress) {
+namespace {
+
+// Fold of each clip (0..folds-1) under the split.
+std::vector<int> assign_folds(const std::vector<Clip>& clips, const CvOptions& cv, int* folds_out) {
   std::vector<int> fold(clips.size(), 0);
   int folds = 0;
   if (cv.split == Split::LeaveSubjectOut) {
@@ -400,34 +403,99 @@ std::vector<ClipResult> cross_validate(const std::vector<Clip>& clips, const Cla
       for (std::size_t i : idx) fold[i] = next++ % folds;
     }
   }
+  *folds_out = folds;
+  return fold;
+}
+
+// Train on the clips outside fold f, score those in it (one thread).
+std::vector<ClipResult> run_fold(const std::vector<Clip>& clips, const std::vector<int>& fold, int f, const ClassMap& map,
+                                 const ClassifierOptions& o) {
+  ClassifierOptions one = o;
+  one.threads = 1;
+  std::vector<const Clip*> train;
+  for (std::size_t i = 0; i < clips.size(); ++i)
+    if (fold[i] != f) train.push_back(&clips[i]);
+  const auto models = train_models(train, map, one);
+  const int K = static_cast<int>(map.classes.size());
+  const auto run = [&](const Sequence& x, double threshold) {
+    return decide(models.hmms, models.cls, K, x, o.hands, o.features.set, threshold, map.garbage_index());
+  };
+  // The threshold in cross-validation: training scores (no inner folds, to keep it affordable).
+  std::vector<double> own;
+  for (const Clip* c : train)
+    if (c->label >= 0 && c->label != map.garbage_index()) own.push_back(run(c->x, 0).scores[static_cast<std::size_t>(c->label)]);
+  const double threshold = quantile(own, o.reject_quantile);
+  std::vector<ClipResult> out;
+  for (std::size_t i = 0; i < clips.size(); ++i)
+    if (fold[i] == f) out.push_back({i, clips[i].label, run(clips[i].x, threshold), f});
+  return out;
+}
+
+std::vector<ClipResult> merged(std::vector<std::vector<ClipResult>>& per_fold) {
+  std::vector<ClipResult> out;
+  for (auto& v : per_fold) out.insert(out.end(), v.begin(), v.end());
+  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.clip < b.clip; });
+  return out;
+}
+
+}  // namespace
+
+std::vector<ClipResult> cross_validate(const std::vector<Clip>& clips, const ClassMap& map, const ClassifierOptions& o,
+                                       const CvOptions& cv, const std::function<void(int, int)>& progress) {
+  int folds = 0;
+  const auto fold = assign_folds(clips, cv, &folds);
   std::vector<std::vector<ClipResult>> per_fold(static_cast<std::size_t>(folds));
   std::atomic<int> done{0};
   std::mutex m;
-  ClassifierOptions inner = o;
-  inner.threads = 1;
   parallel_for(folds, o.threads, [&](int f) {
-    std::vector<const Clip*> train;
-    for (std::size_t i = 0; i < clips.size(); ++i)
-      if (fold[i] != f) train.push_back(&clips[i]);
-    const auto models = train_models(train, map, inner);
-    const int K = static_cast<int>(map.classes.size());
-    const auto run = [&](const Sequence& x, double threshold) {
-      return decide(models.hmms, models.cls, K, x, o.hands, o.features.set, threshold, map.garbage_index());
-    };
-    // The threshold in cross-validation: training scores (no inner folds, to keep it affordable).
-    std::vector<double> own;
-    for (const Clip* c : train)
-      if (c->label >= 0 && c->label != map.garbage_index()) own.push_back(run(c->x, 0).scores[static_cast<std::size_t>(c->label)]);
-    const double threshold = quantile(own, o.reject_quantile);
-    for (std::size_t i = 0; i < clips.size(); ++i)
-      if (fold[i] == f) per_fold[static_cast<std::size_t>(f)].push_back({i, clips[i].label, run(clips[i].x, threshold), f});
+    per_fold[static_cast<std::size_t>(f)] = run_fold(clips, fold, f, map, o);
     std::lock_guard<std::mutex> lock(m);
     ++done;
     if (progress) progress(done, folds);
   });
-  std::vector<ClipResult> out;
-  for (auto& v : per_fold) out.insert(out.end(), v.begin(), v.end());
-  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.clip < b.clip; });
+  return merged(per_fold);
+}
+
+bool better(const Metrics& a, const Metrics& b) {
+  const auto key = [](const Metrics& m) {
+    return std::make_tuple(m.accuracy, m.f1.empty() ? 0.0 : m.f1[0], std::isfinite(m.detection_auc) ? m.detection_auc : 0.0);
+  };
+  return key(a) > key(b);
+}
+
+NestedCv nested_cross_validate(const std::vector<Clip>& clips, const ClassMap& map, const std::vector<ClassifierOptions>& configs,
+                               const CvOptions& cv, const std::function<void(int, int)>& progress) {
+  if (configs.empty()) throw ModelError("nested cross-validation needs at least one configuration");
+  int folds = 0;
+  const auto fold = assign_folds(clips, cv, &folds);
+  NestedCv out;
+  out.chosen.assign(static_cast<std::size_t>(folds), 0);
+  std::vector<std::vector<ClipResult>> per_fold(static_cast<std::size_t>(folds));
+  std::atomic<int> done{0};
+  std::mutex m;
+  parallel_for(folds, configs.front().threads, [&](int f) {
+    // The inner cross-validation sees only this fold's training clips.
+    std::vector<Clip> inner;
+    std::vector<std::size_t> index;
+    for (std::size_t i = 0; i < clips.size(); ++i)
+      if (fold[i] != f) inner.push_back(clips[i]), index.push_back(i);
+    int inner_folds = 0;
+    const auto inner_fold = assign_folds(inner, cv, &inner_folds);
+    std::size_t best = 0;
+    Metrics best_metrics;
+    for (std::size_t c = 0; c < configs.size(); ++c) {
+      std::vector<std::vector<ClipResult>> r(static_cast<std::size_t>(inner_folds));
+      for (int g = 0; g < inner_folds; ++g) r[static_cast<std::size_t>(g)] = run_fold(inner, inner_fold, g, map, configs[c]);
+      const auto metrics = evaluate(merged(r), map.classes);
+      if (c == 0 || better(metrics, best_metrics)) best = c, best_metrics = metrics;
+    }
+    per_fold[static_cast<std::size_t>(f)] = run_fold(clips, fold, f, map, configs[best]);
+    std::lock_guard<std::mutex> lock(m);
+    out.chosen[static_cast<std::size_t>(f)] = static_cast<int>(best);
+    ++done;
+    if (progress) progress(done, folds);
+  });
+  out.results = merged(per_fold);
   return out;
 }
 

@@ -22,8 +22,20 @@ std::vector<std::string> expand_paths(const std::vector<std::string>& paths) {
   return out;
 }
 
+Features recording_features(const playback::Recording& recording, const FeatureOptions& options) {
+  if (!needs_wrists(options.set)) return features_of(recording.frames, options);
+  const auto left = recording.extra_joints.find("left_wrist"), right = recording.extra_joints.find("right_wrist");
+  if (left == recording.extra_joints.end() || right == recording.extra_joints.end())
+    throw ModelError(recording.source + ": the '" + feature_set_name(options.set) + "' features need wrist joints; this " +
+                     recording.format + " recording has none (Kinect v1/v2 formats do)");
+  std::vector<Wrists> wrists(recording.frames.size());
+  for (std::size_t t = 0; t < wrists.size() && t < left->second.size() && t < right->second.size(); ++t)
+    wrists[t] = {left->second[t], right->second[t]};
+  return features_of(recording.frames, options, &wrists);
+}
+
 Sequence clip_features(const playback::Recording& recording, const DatasetOptions& o) {
-  Sequence x = features_of(recording.frames, o.features).x;
+  Sequence x = recording_features(recording, o.features).x;
   if (!o.trim) return x;
   const Span s = motion_span(x, o.features.set);
   return x.middleRows(s.begin, s.end - s.begin);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace skelgraph::gesture {
 
@@ -24,12 +25,29 @@ double to_vertical(const Vector3d& v) {
   return std::acos(std::clamp(v.y() / n, -1.0, 1.0));
 }
 
+// Per-arm values of the angle sets (thesis8, extended, hands).
+enum ArmValue { UpperArmAngle, ForearmAngle, ElbowBend, HandHeight, HandAngle, HandLength, kArmValues };
+constexpr const char* kArmValueNames[kArmValues] = {"upper_arm_angle", "forearm_angle", "elbow_bend",
+                                                    "hand_height",     "hand_angle",    "hand_length"};
+
 // The values of a set (before speeds), and which of them get a speed.
 struct Layout {
   std::vector<std::string> values;
   int speeds = 0;        // the first `speeds` values get a speed
   bool signed_speed = false;
+  std::vector<std::pair<int, int>> arm;  // angle sets: (side, ArmValue) of each value
 };
+
+// Blocks of per-arm values: within a block, the left arm's then the right's
+// (the thesis's order: left upper arm, left forearm, right upper arm, right forearm).
+std::vector<std::vector<ArmValue>> arm_blocks(FeatureSet s, int* speed_blocks) {
+  *speed_blocks = s == FeatureSet::Extended ? 2 : 1;  // the first blocks get speeds
+  switch (s) {
+    case FeatureSet::Extended: return {{UpperArmAngle, ForearmAngle}, {ElbowBend, HandHeight}};
+    case FeatureSet::Hands: return {{UpperArmAngle, ForearmAngle}, {HandAngle, HandLength}};
+    default: return {{UpperArmAngle, ForearmAngle}};
+  }
+}
 
 Layout layout(FeatureSet s) {
   Layout l;
@@ -44,22 +62,21 @@ Layout layout(FeatureSet s) {
     l.signed_speed = true;
     return l;
   }
-  for (const char* side : kSide) {
-    l.values.push_back(std::string(side) + "_upper_arm_angle");
-    l.values.push_back(std::string(side) + "_forearm_angle");
+  int speed_blocks = 0;
+  const auto blocks = arm_blocks(s, &speed_blocks);
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    for (int side = 0; side < 2; ++side)
+      for (const ArmValue v : blocks[b]) {
+        l.values.push_back(std::string(kSide[side]) + "_" + kArmValueNames[v]);
+        l.arm.emplace_back(side, v);
+      }
+    if (static_cast<int>(b) < speed_blocks) l.speeds = static_cast<int>(l.values.size());
   }
-  if (s == FeatureSet::Extended) {
-    for (const char* side : kSide) {
-      l.values.push_back(std::string(side) + "_elbow_bend");
-      l.values.push_back(std::string(side) + "_hand_height");
-    }
-  }
-  l.speeds = static_cast<int>(l.values.size());
   return l;
 }
 
 // The raw values of one frame, NaN where a joint they need is not good.
-VectorXd frame_values(FeatureSet set, const skeleton::Skeleton& s, float min_confidence, int n) {
+VectorXd frame_values(const std::vector<std::pair<int, int>>& arm_layout, int n, FeatureSet set, const skeleton::Skeleton& s, const Wrists* wrists, float min_confidence) {
   const auto good = [&](JointId j) { return s[j].confidence >= min_confidence && s[j].position.allFinite(); };
   VectorXd a = VectorXd::Constant(n, std::nan(""));
   if (set == FeatureSet::Body) {
@@ -92,19 +109,32 @@ VectorXd frame_values(FeatureSet set, const skeleton::Skeleton& s, float min_con
     }
     return a;
   }
+  double arm_value[2][kArmValues];
   for (int side = 0; side < 2; ++side) {
+    double* v = arm_value[side];
+    std::fill(v, v + kArmValues, std::nan(""));
     const Arm& arm = kArms[side];
     const Vector3d sh = s[arm.shoulder].position, el = s[arm.elbow].position, ha = s[arm.hand].position;
-    if (good(arm.shoulder) && good(arm.elbow)) a(2 * side) = to_vertical(el - sh);
-    if (good(arm.elbow) && good(arm.hand)) a(2 * side + 1) = to_vertical(ha - el);
-    if (set == FeatureSet::Extended && good(arm.shoulder) && good(arm.elbow) && good(arm.hand)) {
+    if (good(arm.shoulder) && good(arm.elbow)) v[UpperArmAngle] = to_vertical(el - sh);
+    if (good(arm.elbow) && good(arm.hand)) v[ForearmAngle] = to_vertical(ha - el);
+    if (good(arm.shoulder) && good(arm.elbow) && good(arm.hand)) {
       const Vector3d u = el - sh, f = ha - el;
       if (u.norm() > 1e-9 && f.norm() > 1e-9) {
-        a(4 + 2 * side) = std::acos(std::clamp(u.normalized().dot(f.normalized()), -1.0, 1.0));
-        a(4 + 2 * side + 1) = (ha.y() - sh.y()) / u.norm();
+        v[ElbowBend] = std::acos(std::clamp(u.normalized().dot(f.normalized()), -1.0, 1.0));
+        v[HandHeight] = (ha.y() - sh.y()) / u.norm();
+      }
+    }
+    if (wrists && good(arm.elbow) && good(arm.hand)) {
+      const Vector3d wr = side == 0 ? wrists->left : wrists->right;
+      const Vector3d forearm = wr - el, hand = ha - wr;
+      if (wr.allFinite() && forearm.norm() > 1e-9 && hand.norm() > 1e-9) {
+        v[HandAngle] = to_vertical(hand);
+        v[HandLength] = hand.norm() / forearm.norm();
       }
     }
   }
+  for (std::size_t i = 0; i < arm_layout.size(); ++i)
+    a(static_cast<Eigen::Index>(i)) = arm_value[arm_layout[i].first][arm_layout[i].second];
   return a;
 }
 
@@ -175,6 +205,7 @@ std::optional<FeatureSet> feature_set_from_name(const std::string& name) {
   if (name == "thesis8") return FeatureSet::Thesis8;
   if (name == "extended") return FeatureSet::Extended;
   if (name == "body") return FeatureSet::Body;
+  if (name == "hands") return FeatureSet::Hands;
   return std::nullopt;
 }
 
@@ -183,12 +214,14 @@ const char* feature_set_name(FeatureSet set) {
     case FeatureSet::Thesis8: return "thesis8";
     case FeatureSet::Extended: return "extended";
     case FeatureSet::Body: return "body";
+    case FeatureSet::Hands: return "hands";
   }
   return "?";
 }
 
 FeatureStream::FeatureStream(FeatureOptions options) : o_(options) {
   const Layout l = layout(options.set);
+  arm_ = l.arm;
   values_ = static_cast<int>(l.values.size());
   speeds_ = l.speeds;
   signed_speed_ = l.signed_speed;
@@ -204,8 +237,10 @@ void FeatureStream::reset() {
 
 int FeatureStream::size() const { return values_ + speeds_; }
 
-VectorXd FeatureStream::step(const skeleton::Skeleton& s, bool* complete, VectorXd* raw) {
-  const VectorXd a = frame_values(o_.set, s, o_.min_confidence, values_);
+bool needs_wrists(FeatureSet set) { return set == FeatureSet::Hands; }
+
+VectorXd FeatureStream::step(const skeleton::Skeleton& s, bool* complete, VectorXd* raw, const Wrists* wrists) {
+  const VectorXd a = frame_values(arm_, values_, o_.set, s, wrists, o_.min_confidence);
   if (raw) *raw = a;
   bool all = true;
   double dt = last_dt_;
@@ -232,7 +267,10 @@ VectorXd FeatureStream::step(const skeleton::Skeleton& s, bool* complete, Vector
   return out;
 }
 
-Features features_of(const std::vector<skeleton::Skeleton>& frames, const FeatureOptions& options) {
+Features features_of(const std::vector<skeleton::Skeleton>& frames, const FeatureOptions& options,
+                     const std::vector<Wrists>* wrists) {
+  if (wrists && wrists->size() != frames.size())
+    throw std::invalid_argument("features_of: " + std::to_string(wrists->size()) + " wrist frames for " + std::to_string(frames.size()) + " skeletons");
   FeatureStream fs(options);
   Features f;
   f.x.resize(static_cast<Eigen::Index>(frames.size()), fs.size());
@@ -241,7 +279,7 @@ Features features_of(const std::vector<skeleton::Skeleton>& frames, const Featur
   for (std::size_t t = 0; t < frames.size(); ++t) {
     bool complete = false;
     VectorXd raw;
-    f.x.row(static_cast<Eigen::Index>(t)) = fs.step(frames[t], &complete, &raw).transpose();
+    f.x.row(static_cast<Eigen::Index>(t)) = fs.step(frames[t], &complete, &raw, wrists ? &(*wrists)[t] : nullptr).transpose();
     f.complete.push_back(complete);
     for (int i = 0; i < values; ++i)
       if (std::isfinite(raw(i)) && first_good[static_cast<std::size_t>(i)] < 0) first_good[static_cast<std::size_t>(i)] = static_cast<int>(t);

@@ -100,7 +100,11 @@ PointingCorrection ray_offset(const Vector3d& direction, const Vector3d& truth, 
 }
 
 Spotter::Spotter(const Classifier& classifier, SpotterOptions options)
-    : c_(classifier), o_(std::move(options)), features_(FeatureOptions{classifier.feature_set(), skeleton::kTracked}) {}
+    : c_(classifier), o_(std::move(options)), features_(FeatureOptions{classifier.feature_set(), skeleton::kTracked}) {
+  if (needs_wrists(classifier.feature_set()))
+    throw ModelError(std::string("the model uses the '") + feature_set_name(classifier.feature_set()) +
+                     "' features, which need wrist joints; live skeletons carry none (train with thesis8, extended or body)");
+}
 
 std::vector<SpottedEvent> Spotter::step(const skeleton::Skeleton& s) {
   std::vector<SpottedEvent> out;

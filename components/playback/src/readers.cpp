@@ -73,10 +73,18 @@ void read_rows(CsvReader& csv, const ReadOptions& opt, Recording& rec, Parse par
       if (opt.on_error == ReadOptions::OnError::Stop) throw;
       rec.frames.resize(before);
       if (rec.frame_labels.size() > before) rec.frame_labels.resize(before);
+      for (auto& [name, points] : rec.extra_joints)
+        if (points.size() > before) points.resize(before);
       ++rec.report.skipped;
       if (rec.report.problems.size() < kMaxProblems) rec.report.problems.push_back(e.what());
     }
   }
+}
+
+// The wrists of the frame about to be appended (call just before rec.frames.push_back).
+void add_wrists(Recording& rec, const Eigen::Vector3d& left, const Eigen::Vector3d& right) {
+  rec.extra_joints["left_wrist"].push_back(left);
+  rec.extra_joints["right_wrist"].push_back(right);
 }
 
 void expect_fields(const CsvReader& csv, const std::vector<std::string>& f, std::size_t n, const char* what) {
@@ -136,6 +144,7 @@ Recording read_kinder_gator(const std::string& path, const ReadOptions& opt) {
       rec.metadata["subject"] = f[61];
       rec.metadata["action"] = f[62];
     }
+    add_wrists(rec, xyz(csv, f, 1 + 3 * 6, kV1Joints[6]), xyz(csv, f, 1 + 3 * 10, kV1Joints[10]));
     rec.frames.push_back(std::move(s));
   });
   return rec;
@@ -176,6 +185,13 @@ Recording read_kinect_v2(const std::string& path, const ReadOptions& opt) {
       }
       s.joints[i].confidence = state == 2 ? skeleton::kTracked : state == 1 ? skeleton::kInferred : skeleton::kLost;
     }
+    // Wrists: only where the sensor tracked them (the canonical joints keep inferred ones with confidence 0.5).
+    const auto wrist = [&](std::size_t src) {
+      const auto col = 1 + 4 * src;
+      const bool tracked = csv.integer(f, col + 3, std::string(kV2Joints[src]) + "TrackingState") == 2;
+      return tracked ? xyz(csv, f, col, kV2Joints[src]) : Eigen::Vector3d::Constant(std::nan(""));
+    };
+    add_wrists(rec, wrist(6), wrist(10));
     rec.frames.push_back(std::move(s));
   });
   return rec;
@@ -245,6 +261,14 @@ Recording read_multitrack(const std::string& path, const ReadOptions& opt) {
       s.joints[i].position = missing ? Eigen::Vector3d::Zero() : p;
       s.joints[i].confidence = missing ? skeleton::kLost : skeleton::kTracked;
     }
+    const auto wrist = [&](std::size_t src) {
+      const std::string name = std::string(kMtJoints[src]) + "_";
+      const Eigen::Vector3d p(csv.number(f, 12 + 3 * src, name + "X"), csv.number(f, 13 + 3 * src, name + "Y"),
+                              csv.number(f, 14 + 3 * src, name + "Z"));
+      const bool missing = (p.array() == -9999.0).any() || p.isZero(0.0);
+      return missing ? Eigen::Vector3d::Constant(std::nan("")) : p;
+    };
+    add_wrists(rec, wrist(23), wrist(24));
     if (rec.metadata.empty()) {
       rec.metadata["study"] = f[0];
       rec.metadata["kinect_config"] = f[1];
@@ -280,7 +304,7 @@ Recording read_gesture_phase(const std::string& path, const ReadOptions& opt) {
   rec.metadata["time"] = timed ? "decoded from the packed mmssfff clock" : "none in the file: 30 Hz assumed";
   rec.metadata["units"] = "x, y scaled image coordinates (y flipped to point up), z metres";
   const std::string sensor = opt.sensor_id.empty() ? "kinect" : opt.sensor_id;
-  // Canonical joint -> column of its x (the wrists have no canonical joint).
+  // Canonical joint -> column of its x (the wrists go to extra_joints).
   const std::vector<std::pair<JointId, std::size_t>> map = {
       {JointId::LeftHand, 0}, {JointId::RightHand, 3}, {JointId::Head, 6}, {JointId::Torso, 9}};
   read_rows(csv, opt, rec, [&](const std::vector<std::string>& f) {
@@ -301,10 +325,15 @@ Recording read_gesture_phase(const std::string& path, const ReadOptions& opt) {
                            csv.number(f, col + 2, points[col + 2])};
       s[joint].confidence = skeleton::kTracked;
     }
+    const auto wrist = [&](std::size_t col) {
+      return Eigen::Vector3d(csv.number(f, col, points[col]), -csv.number(f, col + 1, points[col + 1]),
+                             csv.number(f, col + 2, points[col + 2]));
+    };
     auto phase = f.back();
     if (phase.empty()) csv.fail("column 'phase' is empty");
     if (phase == "Prepara\xC3\xA7\xC3\xA3o") phase = "Preparation";  // one Portuguese label in b1_raw.csv
     rec.frame_labels.push_back(phase);
+    add_wrists(rec, wrist(12), wrist(15));
     rec.frames.push_back(std::move(s));
   });
   return rec;

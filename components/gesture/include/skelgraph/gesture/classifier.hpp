@@ -172,4 +172,20 @@ struct CvOptions {
 std::vector<ClipResult> cross_validate(const std::vector<Clip>& clips, const ClassMap& map, const ClassifierOptions& options,
                                        const CvOptions& cv, const std::function<void(int done, int total)>& progress = {});
 
+// Whether `a` beats `b` when choosing a configuration: accuracy, then the first
+// class's F1, then the detection AUC.
+bool better(const Metrics& a, const Metrics& b);
+
+// Nested cross-validation, the honest figure for "try every configuration and
+// keep the best": in each outer fold, every configuration is cross-validated
+// (the same split) on that fold's training clips only, the best (`better`) is
+// trained on all of them and scores the held-out fold. Outer folds run in
+// parallel (the first configuration's `threads`).
+struct NestedCv {
+  std::vector<ClipResult> results;
+  std::vector<int> chosen;  // per outer fold: index into the configurations
+};
+NestedCv nested_cross_validate(const std::vector<Clip>& clips, const ClassMap& map, const std::vector<ClassifierOptions>& configs,
+                               const CvOptions& cv, const std::function<void(int done, int total)>& progress = {});
+
 }  // namespace skelgraph::gesture

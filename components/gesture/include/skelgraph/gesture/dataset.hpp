@@ -16,6 +16,10 @@ struct DatasetOptions {
   bool trim = true;  // keep only the motion_span of each clip (the idle start and end are alike in every class)
 };
 
+// A recording's features (untrimmed), with its wrists for the sets that use
+// them; a ModelError naming the file when such a set meets a recording without.
+Features recording_features(const playback::Recording& recording, const FeatureOptions& options);
+
 // A recording's features as the classifier sees them (trimmed when asked).
 Sequence clip_features(const playback::Recording& recording, const DatasetOptions& options);
 

@@ -17,6 +17,13 @@
 // (per second). Order: hands, knees, elbows, speeds. Left and right are mirror
 // images: out is away from the body on both sides.
 //
+// Hands (Kinect v1/v2 recordings, offline: the skeleton topics carry no
+// wrist): thesis8's four angles, then per arm the hand segment (wrist -> hand):
+// its angle to the vertical (a raised palm turns it up) and its length in
+// forearm lengths (elbow -> wrist; a pointing finger makes it longer); then
+// the speeds of the four thesis angles. Signal-to-stop and push-a-button hold
+// the arm forward like pointing; the hand tells them apart.
+//
 // Missing joints: a frame where a joint an angle needs is below the minimum
 // confidence keeps that angle's last good value (its speed is then 0) and is
 // marked incomplete; frames before the first good value take the first good
@@ -24,7 +31,9 @@
 // increase use the previous interval; intervals shorter than min_interval
 // count as min_interval.
 
+#include <cmath>
 #include <optional>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -35,7 +44,7 @@
 
 namespace skelgraph::gesture {
 
-enum class FeatureSet { Thesis8, Extended, Body };
+enum class FeatureSet { Thesis8, Extended, Body, Hands };
 
 struct FeatureOptions {
   FeatureSet set = FeatureSet::Thesis8;
@@ -44,7 +53,12 @@ struct FeatureOptions {
 };
 
 std::vector<std::string> feature_names(FeatureSet set);
-std::optional<FeatureSet> feature_set_from_name(const std::string& name);  // "thesis8", "extended", "body"
+// Joints beyond the canonical 15 that `hands` uses; NaN: not reported.
+struct Wrists {
+  Eigen::Vector3d left = Eigen::Vector3d::Constant(std::nan("")), right = Eigen::Vector3d::Constant(std::nan(""));
+};
+bool needs_wrists(FeatureSet set);  // without them its wrist values are missing in every frame
+std::optional<FeatureSet> feature_set_from_name(const std::string& name);  // "thesis8", "extended", "body", "hands"
 const char* feature_set_name(FeatureSet set);
 // Column i of a mirrored sequence is column perm[i] of the original: left and right swapped.
 std::vector<int> mirror_permutation(FeatureSet set);
@@ -69,7 +83,8 @@ class FeatureStream {
   explicit FeatureStream(FeatureOptions options = {});
   // The features of the next frame (its stamp_ns gives the interval); `complete`: every joint was good.
   // `raw`: the frame's own values (NaN where missing), before holding.
-  Eigen::VectorXd step(const skeleton::Skeleton& s, bool* complete = nullptr, Eigen::VectorXd* raw = nullptr);
+  Eigen::VectorXd step(const skeleton::Skeleton& s, bool* complete = nullptr, Eigen::VectorXd* raw = nullptr,
+                       const Wrists* wrists = nullptr);
   void reset();
   int size() const;
   int values() const { return values_; }  // the first values() features; the rest are speeds
@@ -78,6 +93,7 @@ class FeatureStream {
   FeatureOptions o_;
   int values_ = 0, speeds_ = 0;
   bool signed_speed_ = false;
+  std::vector<std::pair<int, int>> arm_;  // angle sets: (side, value kind) of each value
   Eigen::VectorXd last_good_;
   std::vector<bool> have_;
   std::int64_t last_ns_ = 0;
@@ -90,6 +106,8 @@ struct Features {
   std::vector<bool> complete;  // per frame
 };
 // A clip's features; frames before the first good value of an angle take that first value.
-Features features_of(const std::vector<skeleton::Skeleton>& frames, const FeatureOptions& options = {});
+// `wrists` (one per frame) for the sets that use them.
+Features features_of(const std::vector<skeleton::Skeleton>& frames, const FeatureOptions& options = {},
+                     const std::vector<Wrists>* wrists = nullptr);
 
 }  // namespace skelgraph::gesture

@@ -46,6 +46,10 @@ struct Recording {
   std::map<std::string, std::string> metadata;  // e.g. action, subject, gesture
   std::vector<skeleton::Skeleton> frames;       // in time order
   std::vector<std::string> frame_labels;        // per frame when the format has them (gesture-phase), else empty
+  // Joints the canonical 15 leave out, one position per frame, when the format
+  // has them: "left_wrist", "right_wrist" (Kinect v1 and v2, gesture-phase).
+  // Gesture features can use them offline; the skeleton topics do not carry them.
+  std::map<std::string, std::vector<Eigen::Vector3d>> extra_joints;
   ReadReport report;
 };
 
