@@ -19,6 +19,17 @@ json_check "$WORK/train.json" 'd["clips"] == 144 and d["labels"] == ["point", "o
 json_check "$WORK/classify.json" 'len(d) == 2 and d[0]["label"] == "point" and d[1]["best"] == "other" and d[0]["scores"]["point"] > d[0]["scores"]["other"]'
 ok "train on 9 subjects, the tenth's pointing clip is pointing and walking is not"
 
+# The same with the hands features (wrists from the Kinect v1 files): "signal to stop" is not pointing.
+"$S" gesture train "$WORK/train" --features hands --states 3 --mixtures 2 --covariance diag --out "$WORK/hands.json" --json \
+  >"$WORK/train_hands.json" 2>"$WORK/train.err" || fail "gesture train --features hands: $(cat "$WORK/train.err")"
+json_check "$WORK/train_hands.json" 'd["config"]["features"] == "hands"'
+"$S" gesture classify --model "$WORK/hands.json" --json "$KG"/*p976_*Point* "$KG"/*p976_*stop* >"$WORK/classify_hands.json" \
+  || fail "gesture classify (hands)"
+json_check "$WORK/classify_hands.json" 'len(d) == 2 and d[0]["label"] == "point" and d[1]["best"] == "other"'
+"$S" gesture features --features hands "$KG"/*p565_24-Point* >"$WORK/hands.csv" || fail "gesture features --features hands"
+head -1 "$WORK/hands.csv" | grep -q "right_hand_length" || fail "hands features header: $(head -1 "$WORK/hands.csv")"
+ok "hands features: train, classify pointing and signal-to-stop apart"
+
 # Five classes, stratified 2-fold, on the labelled clips only.
 mkdir -p "$WORK/five"
 for a in Point-at-the-camera Push-an-imaginary-button Walk-in-place Raise-your-hand- Wave-your-hand-; do ln -s "$KG"/*"$a"* "$WORK/five/"; done

@@ -311,11 +311,12 @@ TEST(Features, MissingJointsAreHeldAndMarked) {
 
 TEST(Features, HandsUseTheWristsWhenGiven) {
   const auto names = feature_names(FeatureSet::Hands);
-  ASSERT_EQ(names.size(), 12u);  // thesis8's 4 angles, 2 hand values per arm, the 4 angles' speeds
-  EXPECT_EQ(names[2], "right_upper_arm_angle");
-  EXPECT_EQ(names[4], "left_hand_angle");
-  EXPECT_EQ(names[7], "right_hand_length");
-  EXPECT_EQ(names[11], "right_forearm_angle_speed");
+  ASSERT_EQ(names.size(), 16u);  // per arm 2 angles + forearm out, per arm 2 hand values, speeds of the first 6
+  EXPECT_EQ(names[2], "left_forearm_out");
+  EXPECT_EQ(names[3], "right_upper_arm_angle");
+  EXPECT_EQ(names[6], "left_hand_angle");
+  EXPECT_EQ(names[9], "right_hand_length");
+  EXPECT_EQ(names[15], "right_forearm_out_speed");
   EXPECT_TRUE(needs_wrists(FeatureSet::Hands));
   EXPECT_FALSE(needs_wrists(FeatureSet::Extended));
   // Right arm forward with the palm raised (the hand segment points up), left arm hanging.
@@ -328,14 +329,21 @@ TEST(Features, HandsUseTheWristsWhenGiven) {
   const std::vector<Wrists> wrists{w};
   const auto f = features_of({pose(e, h, 0)}, o, &wrists);
   EXPECT_EQ(f.complete, std::vector<bool>{true});
-  EXPECT_NEAR(f.x(0, 4), M_PI, 1e-9);   // left hand segment down
-  EXPECT_NEAR(f.x(0, 5), 1.0, 1e-9);    // as long as the left forearm
-  EXPECT_NEAR(f.x(0, 6), 0.0, 1e-9);    // right hand segment straight up
-  EXPECT_NEAR(f.x(0, 7), 0.4, 1e-9);    // 0.1 / 0.25
-  EXPECT_NEAR(f.x(0, 2), M_PI / 2, 1e-9);  // the thesis angles as in thesis8
+  EXPECT_NEAR(f.x(0, 6), M_PI, 1e-9);     // left hand segment down
+  EXPECT_NEAR(f.x(0, 7), 1.0, 1e-9);      // as long as the left forearm
+  EXPECT_NEAR(f.x(0, 8), 0.0, 1e-9);      // right hand segment straight up
+  EXPECT_NEAR(f.x(0, 9), 0.4, 1e-9);      // 0.1 / 0.25
+  EXPECT_NEAR(f.x(0, 3), M_PI / 2, 1e-9);  // the thesis angles as in thesis8
+  EXPECT_NEAR(f.x(0, 5), 0.0, 1e-9);      // right forearm neither out nor across
+  // Forearm out to the right side (the right shoulder is at -x here), then across the body.
+  const std::vector<Wrists> two{w, w};
+  const auto g = features_of({pose(e, e + Eigen::Vector3d(-0.3, 0, 0), 0), pose(e, e + Eigen::Vector3d(0.3, 0, 0), 100'000'000)}, o, &two);
+  EXPECT_NEAR(g.x(0, 5), 1.0, 1e-9);
+  EXPECT_NEAR(g.x(1, 5), -1.0, 1e-9);
+  EXPECT_NEAR(g.x(1, 15), 20.0, 1e-6);  // |-1 - 1| over 0.1 s
   // Without wrists the hand values are missing: held (0 before any) and the frame incomplete.
-  const auto g = features_of({pose(e, h, 0)}, o);
-  EXPECT_EQ(g.complete, std::vector<bool>{false});
-  EXPECT_EQ(g.x(0, 6), 0.0);
+  const auto n = features_of({pose(e, h, 0)}, o);
+  EXPECT_EQ(n.complete, std::vector<bool>{false});
+  EXPECT_EQ(n.x(0, 8), 0.0);
   EXPECT_THROW(features_of({pose(e, h, 0), pose(e, h, 1)}, o, &wrists), std::invalid_argument);  // one wrist per frame
 }

@@ -313,6 +313,7 @@ int gesture_spot(const GestureOptions& o) {
     const auto model = Classifier::train(train, map, c);
     // The stream.
     std::vector<skeleton::Skeleton> stream;
+    std::vector<Wrists> wrists;  // per stream frame, for the hands features
     std::vector<TruthGesture> truth;
     std::int64_t t0 = 0;
     const auto gap = static_cast<std::int64_t>(o.gap * 1e9);
@@ -320,12 +321,17 @@ int gesture_spot(const GestureOptions& o) {
       const auto rec = playback::read_recording(format, clips[i].source);
       const std::int64_t shift = t0 - rec.frames.front().stamp_ns;
       std::int64_t last = t0;
-      for (auto f : rec.frames) {
+      const auto lw = rec.extra_joints.find("left_wrist"), rw = rec.extra_joints.find("right_wrist");
+      for (std::size_t k = 0; k < rec.frames.size(); ++k) {
+        auto f = rec.frames[k];
         f.stamp_ns += shift;
         f.person_id = 1;
         if (!stream.empty() && f.stamp_ns <= stream.back().stamp_ns) continue;
         last = f.stamp_ns;
         stream.push_back(f);
+        Wrists w;
+        if (lw != rec.extra_joints.end() && rw != rec.extra_joints.end()) w = {lw->second[k], rw->second[k]};
+        wrists.push_back(w);
       }
       const auto span = motion_span(recording_features(rec, c.features).x, c.features.set);
       TruthGesture g;
@@ -337,13 +343,14 @@ int gesture_spot(const GestureOptions& o) {
         auto f = stream.back();
         f.stamp_ns = t;
         stream.push_back(f);
+        wrists.push_back(wrists.back());
       }
       t0 = stream.back().stamp_ns + 33'333'333;  // the next clip one frame after the rest
     }
     Spotter spotter(model, o.spot);
     std::vector<SpottedEvent> events;
-    for (const auto& f : stream)
-      for (const auto& e : spotter.step(f)) events.push_back(e);
+    for (std::size_t k = 0; k < stream.size(); ++k)
+      for (const auto& e : spotter.step(stream[k], needs_wrists(c.features.set) ? &wrists[k] : nullptr)) events.push_back(e);
     const auto r = score_spotting(events, truth, label);
     reports.push_back(r);
     per.push_back({{"subject", subject}, {"clips", idx.size()}, {"truth", r.truth}, {"events", r.events},

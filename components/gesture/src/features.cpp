@@ -26,9 +26,10 @@ double to_vertical(const Vector3d& v) {
 }
 
 // Per-arm values of the angle sets (thesis8, extended, hands).
-enum ArmValue { UpperArmAngle, ForearmAngle, ElbowBend, HandHeight, HandAngle, HandLength, kArmValues };
+enum ArmValue { UpperArmAngle, ForearmAngle, ElbowBend, HandHeight, HandAngle, HandLength, ForearmOut, kArmValues };
 constexpr const char* kArmValueNames[kArmValues] = {"upper_arm_angle", "forearm_angle", "elbow_bend",
-                                                    "hand_height",     "hand_angle",    "hand_length"};
+                                                    "hand_height",     "hand_angle",    "hand_length",
+                                                    "forearm_out"};
 
 // The values of a set (before speeds), and which of them get a speed.
 struct Layout {
@@ -44,7 +45,7 @@ std::vector<std::vector<ArmValue>> arm_blocks(FeatureSet s, int* speed_blocks) {
   *speed_blocks = s == FeatureSet::Extended ? 2 : 1;  // the first blocks get speeds
   switch (s) {
     case FeatureSet::Extended: return {{UpperArmAngle, ForearmAngle}, {ElbowBend, HandHeight}};
-    case FeatureSet::Hands: return {{UpperArmAngle, ForearmAngle}, {HandAngle, HandLength}};
+    case FeatureSet::Hands: return {{UpperArmAngle, ForearmAngle, ForearmOut}, {HandAngle, HandLength}};
     default: return {{UpperArmAngle, ForearmAngle}};
   }
 }
@@ -123,6 +124,13 @@ VectorXd frame_values(const std::vector<std::pair<int, int>>& arm_layout, int n,
         v[ElbowBend] = std::acos(std::clamp(u.normalized().dot(f.normalized()), -1.0, 1.0));
         v[HandHeight] = (ha.y() - sh.y()) / u.norm();
       }
+    }
+    if (good(JointId::LeftShoulder) && good(JointId::RightShoulder) && good(arm.elbow) && good(arm.hand)) {
+      // The forearm's direction along the body's outward axis (horizontal, along the shoulders): a wave swings it.
+      Vector3d across = s[JointId::RightShoulder].position - s[JointId::LeftShoulder].position;
+      across.y() = 0;
+      const Vector3d f = ha - el;
+      if (across.norm() > 1e-6 && f.norm() > 1e-9) v[ForearmOut] = f.normalized().dot(side == 0 ? -across.normalized() : across.normalized());
     }
     if (wrists && good(arm.elbow) && good(arm.hand)) {
       const Vector3d wr = side == 0 ? wrists->left : wrists->right;

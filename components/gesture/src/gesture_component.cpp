@@ -29,7 +29,11 @@ Classifier load_model(const std::string& path, const std::string& who) {
     spdlog::info("{}: trained on {} clips", who, clips);
     return c;
   }
-  return Classifier::load(path);
+  auto c = Classifier::load(path);
+  if (needs_wrists(c.feature_set()))
+    throw std::invalid_argument("model: " + path + " uses the '" + feature_set_name(c.feature_set()) +
+                                "' features, which need wrist joints; the skeleton topics carry none (train with thesis8, extended or body)");
+  return c;
 }
 
 msg::Vec3 vec(const Eigen::Vector3d& v) {

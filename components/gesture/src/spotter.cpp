@@ -100,18 +100,17 @@ PointingCorrection ray_offset(const Vector3d& direction, const Vector3d& truth, 
 }
 
 Spotter::Spotter(const Classifier& classifier, SpotterOptions options)
-    : c_(classifier), o_(std::move(options)), features_(FeatureOptions{classifier.feature_set(), skeleton::kTracked}) {
-  if (needs_wrists(classifier.feature_set()))
-    throw ModelError(std::string("the model uses the '") + feature_set_name(classifier.feature_set()) +
-                     "' features, which need wrist joints; live skeletons carry none (train with thesis8, extended or body)");
-}
+    : c_(classifier), o_(std::move(options)), features_(FeatureOptions{classifier.feature_set(), skeleton::kTracked}) {}
 
-std::vector<SpottedEvent> Spotter::step(const skeleton::Skeleton& s) {
+std::vector<SpottedEvent> Spotter::step(const skeleton::Skeleton& s, const Wrists* wrists) {
+  if (!wrists && needs_wrists(c_.feature_set()))
+    throw ModelError(std::string("the model uses the '") + feature_set_name(c_.feature_set()) +
+                     "' features, which need wrist joints; this skeleton stream carries none");
   std::vector<SpottedEvent> out;
   person_ = s.person_id;
   const std::int64_t t = s.stamp_ns;
   const double dt = have_last_ && t > last_ns_ ? static_cast<double>(t - last_ns_) * 1e-9 : 1.0 / 30;
-  const Eigen::VectorXd x = features_.step(s);
+  const Eigen::VectorXd x = features_.step(s, nullptr, nullptr, wrists);
 
   if (s[JointId::LeftShoulder].confidence >= skeleton::kTracked && s[JointId::RightShoulder].confidence >= skeleton::kTracked) {
     Vector3d a = s[JointId::RightShoulder].position - s[JointId::LeftShoulder].position;

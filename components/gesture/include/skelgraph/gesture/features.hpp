@@ -18,11 +18,14 @@
 // images: out is away from the body on both sides.
 //
 // Hands (Kinect v1/v2 recordings, offline: the skeleton topics carry no
-// wrist): thesis8's four angles, then per arm the hand segment (wrist -> hand):
-// its angle to the vertical (a raised palm turns it up) and its length in
-// forearm lengths (elbow -> wrist; a pointing finger makes it longer); then
-// the speeds of the four thesis angles. Signal-to-stop and push-a-button hold
-// the arm forward like pointing; the hand tells them apart.
+// wrist): per arm (left, then right) the thesis's two angles and the
+// forearm's direction along the body's outward axis (horizontal, along the
+// shoulders; -1 across the body .. 1 out to the side: a wave swings it); then
+// per arm the hand segment (wrist -> hand): its angle to the vertical (a
+// raised palm turns it up) and its length in forearm lengths (elbow -> wrist;
+// a pointing finger makes it longer); then the speeds of the first six.
+// Signal-to-stop and push-a-button hold the arm forward like pointing; the
+// hand tells them apart.
 //
 // Missing joints: a frame where a joint an angle needs is below the minimum
 // confidence keeps that angle's last good value (its speed is then 0) and is

@@ -94,7 +94,9 @@ class Spotter {
  public:
   Spotter(const Classifier& classifier, SpotterOptions options = {});
   // The next skeleton of this person (stamps increasing); the events decided on it.
-  std::vector<SpottedEvent> step(const skeleton::Skeleton& s);
+  // `wrists`: required by models on the `hands` features (recorded Kinect
+  // data, offline: the skeleton topics carry no wrists), a ModelError without.
+  std::vector<SpottedEvent> step(const skeleton::Skeleton& s, const Wrists* wrists = nullptr);
   MotionState state() const { return state_; }
   bool in_segment() const { return open_; }
   const SpotterOptions& options() const { return o_; }
