@@ -31,7 +31,7 @@ struct SkelOptions {
   std::vector<std::string> inputs;
   std::string format;  // empty: MCAP recordings
   std::string ref, other, out, ref_pose;
-  double threshold_m = 0.12, clock_search_ms = 0;
+  double threshold_m = 0.12, clock_search_ms = 0, robust_scale_m = 0.05;
   bool holdout = false, json = false;
 };
 
@@ -140,6 +140,7 @@ nlohmann::json calibrate_one(const std::string& path, const SkelOptions& o, skel
   }
   calib::SkeletonCalibOptions co;
   co.inlier_threshold_m = o.threshold_m;
+  co.robust_scale_m = o.robust_scale_m;
   co.max_clock_offset_ns = static_cast<std::int64_t>(o.clock_search_ms * 1e6);
   calib::SkeletonCalibResult r;
   try {
@@ -521,6 +522,8 @@ void add_calib_command(CLI::App& app, GlobalOptions&, Action& run) {
   s->add_option("--ref", o->ref, "reference sensor id (its frame is the result's frame)")->required();
   s->add_option("--other", o->other, "the sensor to calibrate (default: the only other one)");
   s->add_option("--threshold-m", o->threshold_m, "a joint pair agrees within this under a good pose")->check(kPositive);
+  s->add_option("--robust-scale-m", o->robust_scale_m, "scale of the Cauchy weights in the refits, 1 / (1 + (r / this)^2) (default 0.05; 0: plain least squares)")
+      ->check(CLI::NonNegativeNumber);
   s->add_option("--clock-search-ms", o->clock_search_ms,
                 "search the other sensor's clock offset within +-this (0: the clocks agree)")
       ->check(kNonNegative);
