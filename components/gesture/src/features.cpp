@@ -77,7 +77,8 @@ Layout layout(FeatureSet s) {
 }
 
 // The raw values of one frame, NaN where a joint they need is not good.
-VectorXd frame_values(const std::vector<std::pair<int, int>>& arm_layout, int n, FeatureSet set, const skeleton::Skeleton& s, const Wrists* wrists, float min_confidence) {
+VectorXd frame_values(const std::vector<std::pair<int, int>>& arm_layout, int n, FeatureSet set, const skeleton::Skeleton& s,
+                      const Wrists* wrists, float min_confidence) {
   const auto good = [&](JointId j) { return s[j].confidence >= min_confidence && s[j].position.allFinite(); };
   VectorXd a = VectorXd::Constant(n, std::nan(""));
   if (set == FeatureSet::Body) {
@@ -130,7 +131,8 @@ VectorXd frame_values(const std::vector<std::pair<int, int>>& arm_layout, int n,
       Vector3d across = s[JointId::RightShoulder].position - s[JointId::LeftShoulder].position;
       across.y() = 0;
       const Vector3d f = ha - el;
-      if (across.norm() > 1e-6 && f.norm() > 1e-9) v[ForearmOut] = f.normalized().dot(side == 0 ? -across.normalized() : across.normalized());
+      if (across.norm() > 1e-6 && f.norm() > 1e-9)
+        v[ForearmOut] = f.normalized().dot(side == 0 ? Vector3d(-across.normalized()) : across.normalized());
     }
     if (wrists && good(arm.elbow) && good(arm.hand)) {
       const Vector3d wr = side == 0 ? wrists->left : wrists->right;
@@ -278,7 +280,8 @@ VectorXd FeatureStream::step(const skeleton::Skeleton& s, bool* complete, Vector
 Features features_of(const std::vector<skeleton::Skeleton>& frames, const FeatureOptions& options,
                      const std::vector<Wrists>* wrists) {
   if (wrists && wrists->size() != frames.size())
-    throw std::invalid_argument("features_of: " + std::to_string(wrists->size()) + " wrist frames for " + std::to_string(frames.size()) + " skeletons");
+    throw std::invalid_argument("features_of: " + std::to_string(wrists->size()) + " wrist frames for " +
+                                std::to_string(frames.size()) + " skeletons");
   FeatureStream fs(options);
   Features f;
   f.x.resize(static_cast<Eigen::Index>(frames.size()), fs.size());
@@ -287,7 +290,8 @@ Features features_of(const std::vector<skeleton::Skeleton>& frames, const Featur
   for (std::size_t t = 0; t < frames.size(); ++t) {
     bool complete = false;
     VectorXd raw;
-    f.x.row(static_cast<Eigen::Index>(t)) = fs.step(frames[t], &complete, &raw, wrists ? &(*wrists)[t] : nullptr).transpose();
+    const Wrists* w = wrists ? &(*wrists)[t] : nullptr;
+    f.x.row(static_cast<Eigen::Index>(t)) = fs.step(frames[t], &complete, &raw, w).transpose();
     f.complete.push_back(complete);
     for (int i = 0; i < values; ++i)
       if (std::isfinite(raw(i)) && first_good[static_cast<std::size_t>(i)] < 0) first_good[static_cast<std::size_t>(i)] = static_cast<int>(t);
