@@ -58,3 +58,8 @@ for f in "$KG"/*p565_* "$KG"/*p604_* "$KG"/*p734_*; do ln -s "$f" "$WORK/three/"
 "$S" gesture spot "$WORK/three" --states 5 --json >"$WORK/spot.json" 2>"$WORK/spot.err" || fail "gesture spot: $(cat "$WORK/spot.err")"
 json_check "$WORK/spot.json" 'd["spotting"]["truth"] == 3 and len(d["subjects"]) == 3 and d["spotting"]["events"] == d["spotting"]["true_positive"] + d["spotting"]["false_positive"]'
 ok "spotting in continuous streams of real clips, leave-subject-out"
+
+# The same with an arms-down rest put between the clips; the stream is longer by the rests.
+"$S" gesture spot "$WORK/three" --states 5 --rest 1 --json >"$WORK/spot_rest.json" 2>"$WORK/spot.err" || fail "gesture spot --rest: $(cat "$WORK/spot.err")"
+json_check "$WORK/spot_rest.json" 'd["rest_s"] == 1 and d["spotting"]["truth"] == 3 and len(d["subjects"]) == 3'
+ok "spotting with rests between the clips"

@@ -1,5 +1,6 @@
 // skelgraph gesture train|cv|classify: HMM gesture classifiers on recorded data sets.
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -7,6 +8,7 @@
 #include <memory>
 #include <optional>
 #include <set>
+#include <tuple>
 
 #include <unistd.h>
 
@@ -54,6 +56,7 @@ struct GestureOptions {
   int train_sessions = 8, test_sessions = 4;
   SpotterOptions spot;
   double gap = 0.0;
+  double rest = 0.0;
 };
 
 ClassMap class_map(const std::string& c) {
@@ -285,6 +288,26 @@ int gesture_cv(const GestureOptions& o) {
   return 0;
 }
 
+// The same person with both arms hanging: elbows, wrists and hands straight
+// below their shoulders, segment lengths kept.
+std::pair<skeleton::Skeleton, Wrists> arms_down(const skeleton::Skeleton& s, const Wrists& w) {
+  using skeleton::JointId;
+  auto r = s;
+  Wrists rw = w;
+  const Eigen::Vector3d down(0, -1, 0);
+  const JointId arms[2][3] = {{JointId::LeftShoulder, JointId::LeftElbow, JointId::LeftHand},
+                              {JointId::RightShoulder, JointId::RightElbow, JointId::RightHand}};
+  for (int side = 0; side < 2; ++side) {
+    const auto [sh, el, ha] = std::tuple{s[arms[side][0]].position, s[arms[side][1]].position, s[arms[side][2]].position};
+    const Eigen::Vector3d elbow = sh + (el - sh).norm() * down;
+    r[arms[side][1]].position = elbow;
+    r[arms[side][2]].position = elbow + (ha - el).norm() * down;
+    Eigen::Vector3d& wr = side == 0 ? rw.left : rw.right;
+    if (wr.allFinite()) wr = elbow + (wr - el).norm() * down;
+  }
+  return {r, rw};
+}
+
 // Continuous streams of real clips: each subject's recordings (in file-name
 // order: the order they were performed) played one after another with
 // `gap` s of the last frame held between them, spotted by a model trained on
@@ -317,11 +340,49 @@ int gesture_spot(const GestureOptions& o) {
     std::vector<TruthGesture> truth;
     std::int64_t t0 = 0;
     const auto gap = static_cast<std::int64_t>(o.gap * 1e9);
+    constexpr std::int64_t kFrame = 33'333'333;
+    // --rest: from (a, wa) to (b, wb) over `seconds`, 30 Hz, positions blended linearly.
+    const auto move = [&](const skeleton::Skeleton& a, const Wrists& wa, const skeleton::Skeleton& b, const Wrists& wb,
+                          double seconds) {
+      const auto n = static_cast<int>(std::lround(seconds * 30));
+      for (int k = 1; k <= n; ++k) {
+        const double u = static_cast<double>(k) / n;
+        auto f = a;
+        for (std::size_t j = 0; j < f.joints.size(); ++j)
+          f.joints[j].position = (1 - u) * a.joints[j].position + u * b.joints[j].position;
+        f.stamp_ns = stream.empty() ? t0 : stream.back().stamp_ns + kFrame;
+        stream.push_back(f);
+        wrists.push_back({(1 - u) * wa.left + u * wb.left, (1 - u) * wa.right + u * wb.right});
+      }
+    };
+    constexpr double kLower = 0.5;  // s to lower or raise the arms
     for (std::size_t i : idx) {
       const auto rec = playback::read_recording(format, clips[i].source);
+      const auto lw = rec.extra_joints.find("left_wrist"), rw = rec.extra_joints.find("right_wrist");
+      const bool has_wrists = lw != rec.extra_joints.end() && rw != rec.extra_joints.end();
+      const auto wrist_at = [&](std::size_t k) { return has_wrists ? Wrists{lw->second[k], rw->second[k]} : Wrists{}; };
+      if (o.rest > 0) {
+        // Arms down from the last frame, rest, arms up into this clip's first frame.
+        auto first = rec.frames.front();
+        first.person_id = 1;
+        const auto [rest_next, rest_next_w] = arms_down(first, wrist_at(0));
+        if (stream.empty()) {
+          stream.push_back(rest_next);
+          stream.back().stamp_ns = t0;
+          wrists.push_back(rest_next_w);
+          move(rest_next, rest_next_w, rest_next, rest_next_w, o.rest);
+        } else {
+          const auto [rest_prev, rest_prev_w] = arms_down(stream.back(), wrists.back());
+          const auto last_frame = stream.back();
+          const auto last_w = wrists.back();
+          move(last_frame, last_w, rest_prev, rest_prev_w, kLower);
+          move(rest_prev, rest_prev_w, rest_next, rest_next_w, o.rest);
+        }
+        move(rest_next, rest_next_w, first, wrist_at(0), kLower);
+        t0 = stream.back().stamp_ns + kFrame;
+      }
       const std::int64_t shift = t0 - rec.frames.front().stamp_ns;
       std::int64_t last = t0;
-      const auto lw = rec.extra_joints.find("left_wrist"), rw = rec.extra_joints.find("right_wrist");
       for (std::size_t k = 0; k < rec.frames.size(); ++k) {
         auto f = rec.frames[k];
         f.stamp_ns += shift;
@@ -329,9 +390,7 @@ int gesture_spot(const GestureOptions& o) {
         if (!stream.empty() && f.stamp_ns <= stream.back().stamp_ns) continue;
         last = f.stamp_ns;
         stream.push_back(f);
-        Wrists w;
-        if (lw != rec.extra_joints.end() && rw != rec.extra_joints.end()) w = {lw->second[k], rw->second[k]};
-        wrists.push_back(w);
+        wrists.push_back(wrist_at(k));
       }
       const auto span = motion_span(recording_features(rec, c.features).x, c.features.set);
       TruthGesture g;
@@ -345,7 +404,14 @@ int gesture_spot(const GestureOptions& o) {
         stream.push_back(f);
         wrists.push_back(wrists.back());
       }
-      t0 = stream.back().stamp_ns + 33'333'333;  // the next clip one frame after the rest
+      t0 = stream.back().stamp_ns + kFrame;  // the next clip one frame after the rest
+    }
+    if (o.rest > 0 && !stream.empty()) {  // the last clip ends in a rest too
+      const auto [rest_last, rest_last_w] = arms_down(stream.back(), wrists.back());
+      const auto last_frame = stream.back();
+      const auto last_w = wrists.back();
+      move(last_frame, last_w, rest_last, rest_last_w, kLower);
+      move(rest_last, rest_last_w, rest_last, rest_last_w, o.rest);
     }
     Spotter spotter(model, o.spot);
     std::vector<SpottedEvent> events;
@@ -361,13 +427,14 @@ int gesture_spot(const GestureOptions& o) {
   if (tty) std::fprintf(stderr, "\n");
   const auto r = combine(reports);
   if (o.json) {
-    std::printf("%s\n", nlohmann::json{{"label", label}, {"config", config_json(c)}, {"gap_s", o.gap}, {"spotting", to_json(r)},
+    std::printf("%s\n", nlohmann::json{{"label", label}, {"config", config_json(c)}, {"gap_s", o.gap}, {"rest_s", o.rest}, {"spotting", to_json(r)},
                                         {"subjects", per}}
                             .dump(2)
                             .c_str());
     return 0;
   }
-  std::printf("leave-subject-out spotting in continuous streams of %zu clips (%.1f s of rest between them):\n", clips.size(), o.gap);
+  std::printf("leave-subject-out spotting in continuous streams of %zu clips (%.1f s of the last frame held, %.1f s of arms-down rest "
+              "between them):\n", clips.size(), o.gap, o.rest);
   std::printf("%s: %d true, %d events: precision %.3f recall %.3f F1 %.3f; latency from the end of the motion: median %.0f ms\n",
               label.c_str(), r.truth, r.events, r.precision, r.recall, r.f1, 1e3 * r.median_latency_s);
   return 0;
@@ -589,6 +656,10 @@ void add_gesture_command(CLI::App& app, GlobalOptions&, Action& run) {
   auto* sp = g->add_subcommand("spot", "Spot gestures in continuous streams of recorded clips: each subject's clips one "
                                       "after another, a model trained on the other subjects; precision, recall, latency");
   add_common(sp, *o, true);
+  sp->add_option("--rest", o->rest,
+                 "s of rest put between clips (and before the first and after the last): the arms lowered over 0.5 s to hang "
+                 "below the shoulders, held, raised over 0.5 s into the next clip (default 0: none)")
+      ->check(CLI::Range(0.0, 10.0));
   sp->add_option("--gap", o->gap, "s of the last frame held between clips (default 0: the clips' own idle starts and ends are the rest)")->check(CLI::Range(0.0, 10.0));
   sp->add_option("--hold", o->spot.hold, "s an extended arm is held before pointing is tried (default 0.25)")->check(CLI::Range(0.0, 5.0));
   sp->add_option("--still-speed", o->spot.still_speed, "m/s below which a hand is still (default 0.25)")->check(CLI::Range(0.01, 5.0));
