@@ -143,13 +143,17 @@ struct CvRun {
   std::vector<ClipResult> results;
 };
 
-CvRun run_cv(const GestureOptions& o, const ClassMap& map, const std::vector<Clip>& clips, const ClassifierOptions& c,
-             const std::string& what) {
+CvOptions cv_options(const GestureOptions& o) {
   CvOptions cv;
   cv.split = o.split == "kfold" ? Split::KFold : Split::LeaveSubjectOut;
   cv.folds = o.folds;
   cv.seed = o.seed;
-  const auto results = cross_validate(clips, map, c, cv, [&](int done, int total) {
+  return cv;
+}
+
+CvRun run_cv(const GestureOptions& o, const ClassMap& map, const std::vector<Clip>& clips, const ClassifierOptions& c,
+             const std::string& what) {
+  const auto results = cross_validate(clips, map, c, cv_options(o), [&](int done, int total) {
     static const bool tty = isatty(fileno(stderr));
     std::fprintf(stderr, tty ? "\r%s: fold %d/%d" : "%s: fold %d/%d\n", what.c_str(), done, total);
     if (tty && done == total) std::fprintf(stderr, "\n");
@@ -196,11 +200,7 @@ int gesture_cv(const GestureOptions& o) {
   std::optional<NestedCv> nested;
   Metrics nested_metrics;
   if (o.nested) {
-    CvOptions cv;
-    cv.split = o.split == "kfold" ? Split::KFold : Split::LeaveSubjectOut;
-    cv.folds = o.folds;
-    cv.seed = o.seed;
-    nested = nested_cross_validate(clips, map, configs, cv, [&](int done, int total) {
+    nested = nested_cross_validate(clips, map, configs, cv_options(o), [&](int done, int total) {
       static const bool tty = isatty(fileno(stderr));
       std::fprintf(stderr, tty ? "\rnested: outer fold %d/%d" : "nested: outer fold %d/%d\n", done, total);
       if (tty && done == total) std::fprintf(stderr, "\n");
@@ -358,9 +358,8 @@ int gesture_spot(const GestureOptions& o) {
     constexpr double kLower = 0.5;  // s to lower or raise the arms
     for (std::size_t i : idx) {
       const auto rec = playback::read_recording(format, clips[i].source);
-      const auto lw = rec.extra_joints.find("left_wrist"), rw = rec.extra_joints.find("right_wrist");
-      const bool has_wrists = lw != rec.extra_joints.end() && rw != rec.extra_joints.end();
-      const auto wrist_at = [&](std::size_t k) { return has_wrists ? Wrists{lw->second[k], rw->second[k]} : Wrists{}; };
+      const auto rec_wrists = wrists_of(rec);
+      const auto wrist_at = [&](std::size_t k) { return rec_wrists.empty() ? Wrists{} : rec_wrists[k]; };
       if (o.rest > 0) {
         // Arms down from the last frame, rest, arms up into this clip's first frame.
         auto first = rec.frames.front();

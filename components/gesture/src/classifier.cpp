@@ -476,9 +476,8 @@ NestedCv nested_cross_validate(const std::vector<Clip>& clips, const ClassMap& m
   parallel_for(folds, configs.front().threads, [&](int f) {
     // The inner cross-validation sees only this fold's training clips.
     std::vector<Clip> inner;
-    std::vector<std::size_t> index;
     for (std::size_t i = 0; i < clips.size(); ++i)
-      if (fold[i] != f) inner.push_back(clips[i]), index.push_back(i);
+      if (fold[i] != f) inner.push_back(clips[i]);
     int inner_folds = 0;
     const auto inner_fold = assign_folds(inner, cv, &inner_folds);
     std::size_t best = 0;

@@ -22,15 +22,21 @@ std::vector<std::string> expand_paths(const std::vector<std::string>& paths) {
   return out;
 }
 
-Features recording_features(const playback::Recording& recording, const FeatureOptions& options) {
-  if (!needs_wrists(options.set)) return features_of(recording.frames, options);
+std::vector<Wrists> wrists_of(const playback::Recording& recording) {
   const auto left = recording.extra_joints.find("left_wrist"), right = recording.extra_joints.find("right_wrist");
-  if (left == recording.extra_joints.end() || right == recording.extra_joints.end())
-    throw ModelError(recording.source + ": the '" + feature_set_name(options.set) + "' features need wrist joints; this " +
-                     recording.format + " recording has none (Kinect v1/v2 formats do)");
+  if (left == recording.extra_joints.end() || right == recording.extra_joints.end()) return {};
   std::vector<Wrists> wrists(recording.frames.size());
   for (std::size_t t = 0; t < wrists.size() && t < left->second.size() && t < right->second.size(); ++t)
     wrists[t] = {left->second[t], right->second[t]};
+  return wrists;
+}
+
+Features recording_features(const playback::Recording& recording, const FeatureOptions& options) {
+  if (!needs_wrists(options.set)) return features_of(recording.frames, options);
+  const auto wrists = wrists_of(recording);
+  if (wrists.empty() && !recording.frames.empty())
+    throw ModelError(recording.source + ": the '" + feature_set_name(options.set) + "' features need wrist joints; this " +
+                     recording.format + " recording has none (Kinect v1/v2 formats do)");
   return features_of(recording.frames, options, &wrists);
 }
 

@@ -16,6 +16,9 @@ struct DatasetOptions {
   bool trim = true;  // keep only the motion_span of each clip (the idle start and end are alike in every class)
 };
 
+// The recording's wrists, one per frame (from extra_joints); empty when it has none.
+std::vector<Wrists> wrists_of(const playback::Recording& recording);
+
 // A recording's features (untrimmed), with its wrists for the sets that use
 // them; a ModelError naming the file when such a set meets a recording without.
 Features recording_features(const playback::Recording& recording, const FeatureOptions& options);
