@@ -62,4 +62,6 @@ ok "spotting in continuous streams of real clips, leave-subject-out"
 # The same with an arms-down rest put between the clips; the stream is longer by the rests.
 "$S" gesture spot "$WORK/three" --states 5 --rest 1 --json >"$WORK/spot_rest.json" 2>"$WORK/spot.err" || fail "gesture spot --rest: $(cat "$WORK/spot.err")"
 json_check "$WORK/spot_rest.json" 'd["rest_s"] == 1 and d["spotting"]["truth"] == 3 and len(d["subjects"]) == 3'
+# Each event says which clip it came in; each subject lists its 16 clips in stream order, motion inside the clip.
+json_check "$WORK/spot_rest.json" 'sum(len(s["spotted"]) for s in d["subjects"]) == d["spotting"]["events"] and all(len(s["clips_in_stream"]) == s["clips"] == 16 and all(c["clip_start_s"] <= c["motion_start_s"] <= c["motion_end_s"] <= c["clip_end_s"] for c in s["clips_in_stream"]) and all(a["clip_end_s"] < b["clip_start_s"] for a, b in zip(s["clips_in_stream"], s["clips_in_stream"][1:])) and sum(c["label"] == "point" for c in s["clips_in_stream"]) == 1 for s in d["subjects"]) and all(e["clip"] in [c["clip"] for c in s["clips_in_stream"]] + ["rest"] for s in d["subjects"] for e in s["spotted"])'
 ok "spotting with rests between the clips"

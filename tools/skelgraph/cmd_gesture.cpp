@@ -338,6 +338,11 @@ int gesture_spot(const GestureOptions& o) {
     std::vector<skeleton::Skeleton> stream;
     std::vector<Wrists> wrists;  // per stream frame, for the hands features
     std::vector<TruthGesture> truth;
+    struct ClipRange {
+      std::int64_t start_ns, end_ns;
+      std::string action;
+    };
+    std::vector<ClipRange> ranges;  // each clip's place in the stream, to say which clip an event came in
     std::int64_t t0 = 0;
     const auto gap = static_cast<std::int64_t>(o.gap * 1e9);
     constexpr std::int64_t kFrame = 33'333'333;
@@ -382,6 +387,7 @@ int gesture_spot(const GestureOptions& o) {
       }
       const std::int64_t shift = t0 - rec.frames.front().stamp_ns;
       std::int64_t last = t0;
+      ranges.push_back({t0, rec.frames.back().stamp_ns + shift, clips[i].action});
       for (std::size_t k = 0; k < rec.frames.size(); ++k) {
         auto f = rec.frames[k];
         f.stamp_ns += shift;
@@ -418,8 +424,23 @@ int gesture_spot(const GestureOptions& o) {
       for (const auto& e : spotter.step(stream[k], needs_wrists(c.features.set) ? &wrists[k] : nullptr)) events.push_back(e);
     const auto r = score_spotting(events, truth, label);
     reports.push_back(r);
+    nlohmann::json ev = nlohmann::json::array();
+    const std::int64_t origin = stream.empty() ? 0 : stream.front().stamp_ns;
+    for (const auto& e : events) {
+      std::string in = "rest";
+      for (const auto& cr : ranges)
+        if (e.end_ns >= cr.start_ns && e.end_ns <= cr.end_ns) in = cr.action;
+      ev.push_back({{"label", e.label}, {"clip", in}, {"start_s", 1e-9 * static_cast<double>(e.start_ns - origin)},
+                    {"end_s", 1e-9 * static_cast<double>(e.end_ns - origin)}, {"confidence", e.confidence}});
+    }
+    nlohmann::json tj = nlohmann::json::array();
+    for (std::size_t k = 0; k < truth.size(); ++k)
+      tj.push_back({{"clip", ranges[k].action}, {"label", truth[k].label}, {"clip_start_s", 1e-9 * static_cast<double>(ranges[k].start_ns - origin)},
+                    {"clip_end_s", 1e-9 * static_cast<double>(ranges[k].end_ns - origin)},
+                    {"motion_start_s", 1e-9 * static_cast<double>(truth[k].start_ns - origin)},
+                    {"motion_end_s", 1e-9 * static_cast<double>(truth[k].end_ns - origin)}});
     per.push_back({{"subject", subject}, {"clips", idx.size()}, {"truth", r.truth}, {"events", r.events},
-                   {"true_positive", r.true_positive}, {"f1", r.f1}});
+                   {"true_positive", r.true_positive}, {"f1", r.f1}, {"spotted", ev}, {"clips_in_stream", tj}});
     ++done;
     std::fprintf(stderr, tty ? "\rspotted subject %d/%zu" : "spotted subject %d/%zu\n", done, by_subject.size());
   }
