@@ -29,6 +29,14 @@ json_check "$WORK/classify_hands.json" 'len(d) == 2 and d[0]["label"] == "point"
 "$S" gesture features --features hands "$KG"/*p565_24-Point* >"$WORK/hands.csv" || fail "gesture features --features hands"
 head -1 "$WORK/hands.csv" | grep -q "right_hand_length" || fail "hands features header: $(head -1 "$WORK/hands.csv")"
 ok "hands features: train, classify pointing and signal-to-stop apart"
+# The live component refuses such a model: the skeleton topics carry no wrists.
+set +e
+timeout 20 "$S" run gesture -p model="$WORK/hands.json" >"$WORK/run_hands.out" 2>"$WORK/run_hands.err"
+rc=$?
+set -e
+[ "$rc" -eq 1 ] || fail "run gesture with a hands model exited $rc, expected 1 (a component that cannot start): $(cat "$WORK/run_hands.err")"
+grep -q "need wrist joints" "$WORK/run_hands.err" || fail "run gesture with a hands model: $(cat "$WORK/run_hands.err")"
+ok "the gesture component refuses a hands model: $(grep -m1 'wrist' "$WORK/run_hands.err")"
 
 # Five classes, stratified 2-fold, on the labelled clips only.
 mkdir -p "$WORK/five"
