@@ -317,41 +317,43 @@ struct Fuser::Impl {
       // Every sensor's measurement fell outside the gate, but two or more of
       // them agree with each other: it is the filter that is off (a fast
       // movement its constant velocity did not follow), not the sensors.
+      bool agree = true;  // every pair of sensors within the gate of each other
+      for (std::size_t a = 0; agree && a < meas.size(); ++a) {
+        for (std::size_t b = a + 1; agree && b < meas.size(); ++b) {
+          const double sa = meas[a].second, sb = meas[b].second;
+          const double d = (meas[a].first->s.joints[j].position - meas[b].first->s.joints[j].position).norm();
+          agree = d * d <= kGate * (sa * sa + sb * sb);
+        }
+      }
       bool sensors_agree_against_filter = false;
-      if (f.initialised() && meas.size() >= 2 && tr.misses[j] < kResetAfterMisses) {
+      if (f.initialised() && meas.size() >= 2 && tr.misses[j] < kResetAfterMisses && agree) {
         bool all_gated = true;
         for (const auto& [v, sg] : meas) all_gated = all_gated && f.mahalanobis2(v->s.joints[j].position, sg) > kGate;
-        bool agree = all_gated;
-        for (std::size_t a = 0; agree && a < meas.size(); ++a) {
-          for (std::size_t b = a + 1; agree && b < meas.size(); ++b) {
-            const double sa = meas[a].second, sb = meas[b].second;
-            const double d = (meas[a].first->s.joints[j].position - meas[b].first->s.joints[j].position).norm();
-            agree = d * d <= kGate * (sa * sa + sb * sb);
-          }
-        }
-        sensors_agree_against_filter = agree;
+        sensors_agree_against_filter = all_gated;
       }
-      if (!f.initialised() || tr.misses[j] >= kResetAfterMisses || sensors_agree_against_filter) {
-        // Start from the confidence-weighted mean of what the sensors say.
+      if (!meas.empty() && (!f.initialised() || tr.misses[j] >= kResetAfterMisses || sensors_agree_against_filter)) {
+        // Start from the confidence-weighted mean of what the sensors say when
+        // they agree; when they do not, from the most trusted one alone (a mean
+        // of two places is neither, and the filter would then run off towards
+        // one of them with a velocity it never had).
         Vector3d sum = Vector3d::Zero();
         double wsum = 0, sig = 0;
+        const auto best = std::min_element(meas.begin(), meas.end(),
+                                           [](const auto& a, const auto& b) { return a.second < b.second; });
         for (const auto& [v, s] : meas) {
+          if (!agree && v != best->first) continue;
           const double w = 1.0 / (s * s);
           sum += w * v->s.joints[j].position;
           wsum += w;
           sig = std::max(sig, s);
+          oj.sensor_mask |= 1u << v->sensor;
+          tracked = tracked || v->s.joints[j].confidence >= kTracked;
         }
-        if (wsum > 0) {
-          f.reset(sum / wsum, sig, t);
-          tr.misses[j] = 0;
-          tr.last_update_ns[j] = t;
-          for (const auto& [v, s] : meas) {
-            oj.sensor_mask |= 1u << v->sensor;
-            tracked = tracked || v->s.joints[j].confidence >= kTracked;
-          }
-          any = true;
-        }
-      } else {
+        f.reset(sum / wsum, sig, t);
+        tr.misses[j] = 0;
+        tr.last_update_ns[j] = t;
+        any = true;
+      } else if (f.initialised()) {
         f.predict(t);
         for (const auto& [v, s] : meas) {
           const Vector3d z = v->s.joints[j].position;
