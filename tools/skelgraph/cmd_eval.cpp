@@ -6,7 +6,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <algorithm>
+#include <limits>
 #include <map>
+#include <queue>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -167,20 +170,39 @@ std::string write_report_page(const std::string& dir, const std::string& heading
   return path.string();
 }
 
-// A recording's raw skeletons, truth (both at their log time, the recorder's
-// clock) and sensor poses (the latest per sensor in the file).
+// What a recording holds for evaluation, from a first pass over it: sensor
+// poses (the latest per sensor in the file), sync ticks, counts, and the ids
+// of the streams. The skeletons themselves are streamed by for_each_event.
 struct RecordingInputs {
+  std::string file;
   std::map<std::string, Eigen::Isometry3d> poses;
-  std::vector<eval::TimedSkeleton> events;
   std::vector<std::int64_t> ticks;  // log times of the sync TICKs, if the session was synchronised
   std::uint64_t raw = 0, truth = 0, fused = 0;  // fused: recorded live fusion output
+  std::vector<std::string> sensor_ids, recorded_ids;  // in order of first appearance
+  std::int64_t lateness_ns = 0;  // the most a skeleton's log time falls behind an earlier one's in the file
 };
+
+// Calls f(kind, log_time, message bytes) for every skeleton on the raw, truth and fused topics, in file order.
+template <typename F>
+void for_each_skeleton_message(const mcap::Reader& reader, F&& f) {
+  reader.for_each_message([&](const mcap::Channel& ch, const mcap::Schema* schema, const mcap::Message& m) {
+    if (schema == nullptr || schema->name != msg::MessageTraits<msg::Skeleton>::name) return;
+    const bool raw = ch.topic == runtime::topics::kSkeletonRaw.name;
+    const bool truth = ch.topic == runtime::topics::kSkeletonTruth.name;
+    const bool fused = ch.topic == runtime::topics::kSkeletonFused.name;
+    if (!raw && !truth && !fused) return;
+    f(raw ? eval::TimedSkeleton::Kind::Raw : truth ? eval::TimedSkeleton::Kind::Truth : eval::TimedSkeleton::Kind::Fused,
+      static_cast<std::int64_t>(m.log_time),
+      skeleton::from_msg(msg::from_cdr<msg::Skeleton>(reinterpret_cast<const std::uint8_t*>(m.data.data()), m.data.size())));
+  });
+}
 
 // shared_frame: every sensor's skeletons are already in one frame (data sets
 // such as KinectMultiTrack map them so): identity poses, no calibration needed.
 // calibration: a calibration file whose poses replace the recording's.
 RecordingInputs read_recording(const std::string& file, bool shared_frame, const std::string& calibration = "") {
   RecordingInputs in;
+  in.file = file;
   try {
     const mcap::Reader reader(file);
     reader.for_each_message([&](const mcap::Channel& ch, const mcap::Schema* schema, const mcap::Message& m) {
@@ -193,25 +215,24 @@ RecordingInputs read_recording(const std::string& file, bool shared_frame, const
         if (msg::from_cdr<msg::SyncCommand>(bytes, m.data.size()).kind() == msg::SYNC_TICK) {
           in.ticks.push_back(static_cast<std::int64_t>(m.log_time));
         }
-      } else if (schema->name == msg::MessageTraits<msg::Skeleton>::name) {
-        const bool raw = ch.topic == runtime::topics::kSkeletonRaw.name;
-        const bool truth = ch.topic == runtime::topics::kSkeletonTruth.name;
-        const bool fused = ch.topic == runtime::topics::kSkeletonFused.name;
-        if (!raw && !truth && !fused) return;
-        in.events.push_back({raw     ? eval::TimedSkeleton::Kind::Raw
-                             : truth ? eval::TimedSkeleton::Kind::Truth
-                                     : eval::TimedSkeleton::Kind::Fused,
-                             static_cast<std::int64_t>(m.log_time),
-                             skeleton::from_msg(msg::from_cdr<msg::Skeleton>(bytes, m.data.size()))});
-        ++(raw ? in.raw : truth ? in.truth : in.fused);
       }
+    });
+    std::int64_t latest = std::numeric_limits<std::int64_t>::min();
+    for_each_skeleton_message(reader, [&](eval::TimedSkeleton::Kind kind, std::int64_t t, const skeleton::Skeleton& s) {
+      if (latest != std::numeric_limits<std::int64_t>::min()) in.lateness_ns = std::max(in.lateness_ns, latest - t);
+      latest = std::max(latest, t);
+      if (kind == eval::TimedSkeleton::Kind::Truth) {
+        ++in.truth;
+        return;
+      }
+      auto& ids = kind == eval::TimedSkeleton::Kind::Raw ? in.sensor_ids : in.recorded_ids;
+      if (std::find(ids.begin(), ids.end(), s.sensor_id) == ids.end()) ids.push_back(s.sensor_id);
+      ++(kind == eval::TimedSkeleton::Kind::Raw ? in.raw : in.fused);
     });
   } catch (const mcap::McapError& e) {
     throw UsageError(e.what());
   }
   std::sort(in.ticks.begin(), in.ticks.end());
-  std::stable_sort(in.events.begin(), in.events.end(),
-                   [](const eval::TimedSkeleton& a, const eval::TimedSkeleton& b) { return a.t_ns < b.t_ns; });
   if (in.raw == 0) throw UsageError(file + ": no raw skeletons on " + runtime::topics::kSkeletonRaw.name);
   if (!calibration.empty()) {
     try {
@@ -220,14 +241,42 @@ RecordingInputs read_recording(const std::string& file, bool shared_frame, const
       throw UsageError(e.what());
     }
   }
-  for (const auto& e : in.events) {
-    if (shared_frame && e.kind == eval::TimedSkeleton::Kind::Raw) in.poses.try_emplace(e.skeleton.sensor_id, Eigen::Isometry3d::Identity());
-    if (e.kind == eval::TimedSkeleton::Kind::Raw && !in.poses.count(e.skeleton.sensor_id)) {
-      throw UsageError(file + ": no pose of sensor '" + e.skeleton.sensor_id + "' on " +
-                       runtime::topics::kCalibration.name + " (calibrate it, record the calibration topic, or --shared-frame if the data is already in one frame)");
+  for (const auto& id : in.sensor_ids) {
+    if (shared_frame) in.poses.try_emplace(id, Eigen::Isometry3d::Identity());
+    if (!in.poses.count(id)) {
+      throw UsageError(file + ": no pose of sensor '" + id + "' on " + runtime::topics::kCalibration.name +
+                       " (calibrate it, record the calibration topic, or --shared-frame if the data is already in one frame)");
     }
   }
   return in;
+}
+
+// The recording's skeletons into `ev` in time order (ties in file order): a
+// second pass, held back only as far as the file's own disorder (lateness_ns)
+// requires, so a long recording is never held whole.
+void stream_recording(const RecordingInputs& in, eval::Evaluator& ev) {
+  struct Held {
+    eval::TimedSkeleton e;
+    std::uint64_t seq;
+  };
+  const auto later = [](const Held& a, const Held& b) { return a.e.t_ns != b.e.t_ns ? a.e.t_ns > b.e.t_ns : a.seq > b.seq; };
+  std::priority_queue<Held, std::vector<Held>, decltype(later)> held(later);
+  std::uint64_t seq = 0;
+  std::int64_t latest = std::numeric_limits<std::int64_t>::min();
+  try {
+    const mcap::Reader reader(in.file);
+    for_each_skeleton_message(reader, [&](eval::TimedSkeleton::Kind kind, std::int64_t t, skeleton::Skeleton s) {
+      latest = std::max(latest, t);
+      held.push({{kind, t, std::move(s)}, seq++});
+      while (!held.empty() && held.top().e.t_ns <= latest - in.lateness_ns) {
+        ev.add(held.top().e);
+        held.pop();
+      }
+    });
+  } catch (const mcap::McapError& e) {
+    throw UsageError(e.what());
+  }
+  for (; !held.empty(); held.pop()) ev.add(held.top().e);
 }
 
 struct FileOptions {
@@ -267,7 +316,9 @@ ScoredRecording score_recording(const FileOptions& o, bool trace) {
   ScoredRecording s{read_recording(o.file, o.shared_frame, o.calibration), {}, {}};
   auto eo = offline_options(o, s.in);
   eo.trace = trace;
-  s.result = eval::evaluate(s.in.poses, s.in.events, eo);
+  eval::Evaluator ev(s.in.poses, s.in.sensor_ids, s.in.recorded_ids, eo);
+  stream_recording(s.in, ev);
+  s.result = ev.finish();
   nlohmann::json streams = nlohmann::json::array();
   for (const auto& st : s.result.streams) streams.push_back(stream_json(st));
   s.summary = {{"file", o.file},
@@ -319,12 +370,14 @@ int fuse_file(const FileOptions& o) {
   auto eo = offline_options(o, in);
   eo.singles = false;  // only the methods go into the file
   std::vector<std::pair<std::int64_t, skeleton::Skeleton>> fused;
-  const auto r = eval::evaluate(in.poses, in.events, eo,
-                                [&](fusion::Method m, const skeleton::Skeleton& s) {
-                                  auto f = s;
-                                  f.sensor_id = eo.methods.size() == 1 ? "fused" : std::string("fused_") + fusion::method_name(m);
-                                  fused.emplace_back(s.stamp_ns + eo.fuser.delay_ns, std::move(f));
-                                });
+  // The fused output is held until it is merged into the copy (the input is streamed).
+  eval::Evaluator ev(in.poses, in.sensor_ids, {}, eo, [&](fusion::Method m, const skeleton::Skeleton& s) {
+    auto f = s;
+    f.sensor_id = eo.methods.size() == 1 ? "fused" : std::string("fused_") + fusion::method_name(m);
+    fused.emplace_back(s.stamp_ns + eo.fuser.delay_ns, std::move(f));
+  });
+  stream_recording(in, ev);
+  const auto r = ev.finish();
   std::stable_sort(fused.begin(), fused.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   std::uint64_t copied = 0;
   try {
@@ -410,6 +463,7 @@ int eval_sim(const SimEvalOptions& o) {
     std::map<std::string, Eigen::Isometry3d> poses;
     for (const auto& s : cfg.sensors) poses[s.id] = s.world_from_sensor();
     std::vector<eval::TimedSkeleton> events;
+    eval::OfflineResult r;
     const bool progress = !o.json && !o.quiet;
     nlohmann::json depth_info;
     if (o.source == "depth" || o.source == "depth-merged") {
@@ -431,16 +485,29 @@ int eval_sim(const SimEvalOptions& o) {
                     {"render_ms_per_frame", d.frames ? 1e3 * d.render_s / d.frames : 0.0},
                     {"track_ms_per_frame", d.frames ? 1e3 * d.track_s / d.frames : 0.0}};
     } else {
+      // Simulated and scored a minute at a time: an hour-long session is never held whole.
       sim::Simulation sim(cfg);
-      for (auto& e : sim.advance(sim.duration() + 1.0)) {
-        const auto t = cfg.epoch_ns + static_cast<std::int64_t>(std::llround(e.t * 1e9));
-        events.push_back({e.kind == sim::SimEvent::Kind::Truth ? eval::TimedSkeleton::Kind::Truth
-                                                                : eval::TimedSkeleton::Kind::Raw,
-                          t, std::move(e.skeleton)});
+      std::vector<std::string> ids;
+      for (const auto& s : cfg.sensors) ids.push_back(s.id);
+      eval::Evaluator ev(poses, ids, {}, eo);
+      const double end = sim.duration() + 1.0;
+      for (double until = 60.0;; until += 60.0) {
+        for (auto& e : sim.advance(std::min(until, end))) {
+          const auto t = cfg.epoch_ns + static_cast<std::int64_t>(std::llround(e.t * 1e9));
+          ev.add({e.kind == sim::SimEvent::Kind::Truth ? eval::TimedSkeleton::Kind::Truth : eval::TimedSkeleton::Kind::Raw,
+                  t, std::move(e.skeleton)});
+        }
+        if (progress)
+          std::fprintf(stderr, "\rsimulating and evaluating %s: %.0f of %.0f s...      ", scenario.c_str(),
+                       std::min(until, end), end);
+        if (until >= end) break;
       }
+      r = ev.finish();
     }
-    if (progress) std::fprintf(stderr, "\revaluating %s (%zu events)...      ", scenario.c_str(), events.size());
-    const auto r = eval::evaluate(poses, events, eo);
+    if (!events.empty()) {
+      if (progress) std::fprintf(stderr, "\revaluating %s (%zu events)...      ", scenario.c_str(), events.size());
+      r = eval::evaluate(poses, events, eo);
+    }
     if (progress) std::fprintf(stderr, "\r%50s\r", "");
     if (o.quiet) std::fprintf(stderr, "evaluated %s: %zu streams over %llu ticks\n", scenario.c_str(), r.streams.size(),
                               static_cast<unsigned long long>(r.ticks));

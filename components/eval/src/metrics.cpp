@@ -124,6 +124,13 @@ std::optional<skeleton::Skeleton> TruthTimeline::at(std::int64_t t_ns, const Eig
   return best;
 }
 
+void TruthTimeline::forget_before(std::int64_t t_ns) {
+  for (auto& [id, v] : by_person_) {
+    const auto first_kept = std::lower_bound(v.begin(), v.end(), t_ns, [](const auto& p, std::int64_t x) { return p.first < x; });
+    if (first_kept - v.begin() > 1) v.erase(v.begin(), first_kept - 1);
+  }
+}
+
 bool TruthTimeline::covers(std::int64_t t_ns, std::int64_t max_gap_ns) const {
   return std::any_of(by_person_.begin(), by_person_.end(),
                      [&](const auto& p) { return interpolate(p.second, t_ns, max_gap_ns).has_value(); });

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
+#include <stdexcept>
+#include <string>
 #include <limits>
 #include <optional>
 
@@ -82,71 +85,83 @@ struct OffsetModel {
 };
 }  // namespace
 
-OfflineResult evaluate(const std::map<std::string, Eigen::Isometry3d>& world_from_sensor,
-                       const std::vector<TimedSkeleton>& events, const OfflineOptions& options,
-                       const FusedSink& sink) {
+struct Evaluator::Impl {
   struct Lane {
+    enum class Kind { Single, Method, Recorded };
+    Kind kind = Kind::Method;
     StreamScore score;
     fusion::Fuser fuser;
     std::string only_sensor;  // singles: the one sensor fed
-    fusion::Method method;
+    fusion::Method method = fusion::Method::Avg;
     OffsetModel offsets;
     std::string recorded;  // a live fusion component's output id: its recorded skeletons, no fuser
     std::map<std::uint32_t, std::pair<std::int64_t, skeleton::Skeleton>> latest;  // recorded: per person
   };
+
+  std::map<std::string, Eigen::Isometry3d> poses;
+  OfflineOptions options;
+  FusedSink sink;
+  std::int64_t horizon_ns;
   std::vector<Lane> lanes;
-  std::vector<std::string> sensor_ids, recorded_ids;
-  for (const auto& e : events) {
-    auto& ids = e.kind == TimedSkeleton::Kind::Raw ? sensor_ids : recorded_ids;
-    if (e.kind != TimedSkeleton::Kind::Truth && std::find(ids.begin(), ids.end(), e.skeleton.sensor_id) == ids.end()) {
-      ids.push_back(e.skeleton.sensor_id);
-    }
-  }
-  auto make_lane = [&](const std::string& name, bool fused, fusion::Method m, const std::string& only) {
+  std::deque<TimedSkeleton> pending;  // added, not yet consumed by a tick
+  TruthTimeline truth;
+  OfflineResult result;
+  std::int64_t first_truth = 0, last_event = 0, last_raw = 0, next_tick = 0;
+  bool any_truth = false, any_raw = false, any_event = false;
+  std::size_t next_tick_index = 0;  // into options.tick_times
+
+  Impl(std::map<std::string, Eigen::Isometry3d> p, OfflineOptions o, FusedSink s, std::int64_t h)
+      : poses(std::move(p)), options(std::move(o)), sink(std::move(s)), horizon_ns(h) {}
+
+  void make_lane(Lane::Kind kind, const std::string& name, fusion::Method m, const std::string& only,
+                 const std::string& recorded) {
     auto fo = options.fuser;
     fo.method = m;
-    Lane lane{{}, fusion::Fuser(fo), only, m, {}, {}, {}};
+    Lane lane{kind, {}, fusion::Fuser(fo), only, m, {}, recorded, {}};
     lane.score.name = name;
-    lane.score.fused = fused;
-    for (const auto& [id, pose] : world_from_sensor) lane.fuser.set_pose(id, pose);
+    lane.score.fused = kind != Lane::Kind::Single;
+    lane.score.ticks = result.ticks;  // a stream added late had nothing to show on the ticks before
+    for (const auto& [id, pose] : poses) lane.fuser.set_pose(id, pose);
     lanes.push_back(std::move(lane));
-  };
-  if (options.singles) {
-    for (const auto& id : sensor_ids) make_lane(id, false, fusion::Method::Avg, id);
   }
-  for (const auto m : options.methods) make_lane(fusion::method_name(m), true, m, "");
-  for (const auto& id : recorded_ids) {
-    make_lane("live " + id, true, fusion::Method::Avg, "");
-    lanes.back().recorded = id;
-  }
-
-  OfflineResult result;
-  TruthTimeline truth;
-  std::int64_t first = 0, last = 0, first_truth = 0;
-  bool any_truth = false;
-  bool any_raw = false;
-  for (const auto& e : events) {
-    if (e.kind == TimedSkeleton::Kind::Truth) {
-      truth.add(e.skeleton, e.t_ns);
-      if (!any_truth || e.t_ns < first_truth) first_truth = e.t_ns;
-      any_truth = true;
-      result.has_truth = true;
-    } else if (e.kind == TimedSkeleton::Kind::Raw) {
-      if (!any_raw) first = e.t_ns;
-      last = std::max(last, e.t_ns);
-      any_raw = true;
+  void ensure_lane(const TimedSkeleton& e) {
+    if (e.kind == TimedSkeleton::Kind::Raw && options.singles) {
+      for (const auto& l : lanes)
+        if (l.kind == Lane::Kind::Single && l.only_sensor == e.skeleton.sensor_id) return;
+      make_lane(Lane::Kind::Single, e.skeleton.sensor_id, fusion::Method::Avg, e.skeleton.sensor_id, "");
+    } else if (e.kind == TimedSkeleton::Kind::Fused) {
+      for (const auto& l : lanes)
+        if (l.recorded == e.skeleton.sensor_id) return;
+      make_lane(Lane::Kind::Recorded, "live " + e.skeleton.sensor_id, fusion::Method::Avg, "", e.skeleton.sensor_id);
     }
   }
-  if (!any_raw) return result;
-  std::vector<std::int64_t> ticks = options.tick_times;
-  if (ticks.empty()) {
-    for (std::int64_t tick = first; tick <= last + options.period_ns; tick += options.period_ns) ticks.push_back(tick);
+
+  // The next tick, if there is one before `limit` (inclusive).
+  std::optional<std::int64_t> tick_before(std::int64_t limit) const {
+    if (!options.tick_times.empty()) {
+      if (next_tick_index < options.tick_times.size() && options.tick_times[next_tick_index] <= limit)
+        return options.tick_times[next_tick_index];
+      return std::nullopt;
+    }
+    if (!any_raw || next_tick > limit) return std::nullopt;
+    return next_tick;
   }
-  std::size_t next = 0;
-  for (const std::int64_t tick : ticks) {
+  void advance_tick() {
+    if (!options.tick_times.empty()) ++next_tick_index;
+    else next_tick += options.period_ns;
+  }
+
+  void run_ticks(std::int64_t limit) {
+    while (const auto tick = tick_before(limit)) {
+      run_tick(*tick);
+      advance_tick();
+    }
+  }
+
+  void run_tick(std::int64_t tick) {
     // Everything that arrived up to this tick goes in first.
-    for (; next < events.size() && events[next].t_ns <= tick; ++next) {
-      const auto& e = events[next];
+    for (; !pending.empty() && pending.front().t_ns <= tick; pending.pop_front()) {
+      const auto& e = pending.front();
       if (e.kind == TimedSkeleton::Kind::Fused) {
         for (auto& lane : lanes) {
           if (lane.recorded == e.skeleton.sensor_id) lane.latest[e.skeleton.person_id] = {e.t_ns, e.skeleton};
@@ -160,6 +175,7 @@ OfflineResult evaluate(const std::map<std::string, Eigen::Isometry3d>& world_fro
     }
     ++result.ticks;
     const std::int64_t at = tick - options.fuser.delay_ns;
+    truth.forget_before(at - 1'000'000'000);
     const bool truth_here = truth.covers(at);
     for (auto& lane : lanes) {
       std::vector<skeleton::Skeleton> fused;
@@ -183,69 +199,137 @@ OfflineResult evaluate(const std::map<std::string, Eigen::Isometry3d>& world_fro
       if (!fused.empty()) ++lane.score.with_output;
       for (const auto& f : fused) lane.score.steadiness.add(f);
       if (!truth_here) continue;
-      // Each true person is scored against the fused person nearest it; a
-      // person nobody reports is a missed frame.
-      bool scored = false;
-      TracePoint tp;
-      tp.t_ns = at;
-      tp.error_cm.fill(std::nan(""));
-      // The fused person nearest the true one is the person; others are ghosts.
-      std::vector<const skeleton::Skeleton*> order;
-      for (const auto& f : fused) order.push_back(&f);
-      const auto dist = [&](const skeleton::Skeleton* f) {
-        const auto c = skeleton::centre_of(*f);
-        const auto t = c ? truth.at(at, *c) : std::nullopt;
-        return t ? ((*t)[skeleton::JointId::Torso].position - *c).norm() : std::numeric_limits<double>::infinity();
-      };
-      std::stable_sort(order.begin(), order.end(), [&](auto* a, auto* b) { return dist(a) < dist(b); });
-      for (const auto* fp : order) {
-        const auto& f = *fp;
-        const auto c = skeleton::centre_of(f);
-        if (!c) continue;
-        const auto t = truth.at(at, *c);
-        if (!t || ((*t)[skeleton::JointId::Torso].position - *c).norm() > 1.0) continue;  // a ghost, not the person
-        lane.score.accuracy.add(f, *t);
-        scored = true;
-        if (at - first_truth < static_cast<std::int64_t>(options.compensation_s * 1e9)) {
-          const auto before = truth.at(at - 100'000'000, (*t)[skeleton::JointId::Torso].position);
-          const double speed =
-              before ? ((*t)[skeleton::JointId::Torso].position - (*before)[skeleton::JointId::Torso].position).norm() / 0.1
-                     : std::numeric_limits<double>::infinity();
-          lane.offsets.learn(f, *t, at, speed);
-        } else {
-          lane.score.compensated.add(lane.offsets.apply(f, *t), *t);
-          lane.score.after_calibration.add(f, *t);
-        }
-        if (options.trace) {
-          std::array<double, kGroupCount> sum{}, n{};
-          for (std::size_t j = 0; j < skeleton::kJointCount; ++j) {
-            const int g = group_of(skeleton::joint_at(j));
-            if (g < 0 || f.joints[j].confidence < skeleton::kTracked) continue;
-            sum[g] += 100.0 * (f.joints[j].position - t->joints[j].position).norm();
-            n[g] += 1;
-          }
-          for (std::size_t g = 0; g < kGroupCount; ++g) tp.error_cm[g] = n[g] > 0 ? sum[g] / n[g] : std::nan("");
-          const auto& tj = f[options.trace_joint];
-          if (tj.confidence >= skeleton::kTracked) tp.joint = tj.position;
-          tp.truth = (*t)[options.trace_joint].position;
-        }
-        break;
-      }
-      if (!scored) {
-        lane.score.accuracy.add_missed();
-        if (at - first_truth >= static_cast<std::int64_t>(options.compensation_s * 1e9)) {
-          lane.score.compensated.add_missed();
-          lane.score.after_calibration.add_missed();
-        }
-      }
-      if (options.trace) lane.score.trace.push_back(tp);
+      score(lane, fused, at);
     }
   }
-  for (auto& lane : lanes) {
-    result.streams.push_back(std::move(lane.score));
-    result.fuser_stats.push_back(lane.fuser.stats());
+
+  // Each true person is scored against the fused person nearest it; a
+  // person nobody reports is a missed frame.
+  void score(Lane& lane, const std::vector<skeleton::Skeleton>& fused, std::int64_t at) {
+    bool scored = false;
+    TracePoint tp;
+    tp.t_ns = at;
+    tp.error_cm.fill(std::nan(""));
+    // The fused person nearest the true one is the person; others are ghosts.
+    std::vector<const skeleton::Skeleton*> order;
+    for (const auto& f : fused) order.push_back(&f);
+    const auto dist = [&](const skeleton::Skeleton* f) {
+      const auto c = skeleton::centre_of(*f);
+      const auto t = c ? truth.at(at, *c) : std::nullopt;
+      return t ? ((*t)[skeleton::JointId::Torso].position - *c).norm() : std::numeric_limits<double>::infinity();
+    };
+    std::stable_sort(order.begin(), order.end(), [&](auto* a, auto* b) { return dist(a) < dist(b); });
+    for (const auto* fp : order) {
+      const auto& f = *fp;
+      const auto c = skeleton::centre_of(f);
+      if (!c) continue;
+      const auto t = truth.at(at, *c);
+      if (!t || ((*t)[skeleton::JointId::Torso].position - *c).norm() > 1.0) continue;  // a ghost, not the person
+      lane.score.accuracy.add(f, *t);
+      scored = true;
+      if (at - first_truth < static_cast<std::int64_t>(options.compensation_s * 1e9)) {
+        const auto before = truth.at(at - 100'000'000, (*t)[skeleton::JointId::Torso].position);
+        const double speed =
+            before ? ((*t)[skeleton::JointId::Torso].position - (*before)[skeleton::JointId::Torso].position).norm() / 0.1
+                   : std::numeric_limits<double>::infinity();
+        lane.offsets.learn(f, *t, at, speed);
+      } else {
+        lane.score.compensated.add(lane.offsets.apply(f, *t), *t);
+        lane.score.after_calibration.add(f, *t);
+      }
+      if (options.trace) {
+        std::array<double, kGroupCount> sum{}, n{};
+        for (std::size_t j = 0; j < skeleton::kJointCount; ++j) {
+          const int g = group_of(skeleton::joint_at(j));
+          if (g < 0 || f.joints[j].confidence < skeleton::kTracked) continue;
+          sum[g] += 100.0 * (f.joints[j].position - t->joints[j].position).norm();
+          n[g] += 1;
+        }
+        for (std::size_t g = 0; g < kGroupCount; ++g) tp.error_cm[g] = n[g] > 0 ? sum[g] / n[g] : std::nan("");
+        const auto& tj = f[options.trace_joint];
+        if (tj.confidence >= skeleton::kTracked) tp.joint = tj.position;
+        tp.truth = (*t)[options.trace_joint].position;
+      }
+      break;
+    }
+    if (!scored) {
+      lane.score.accuracy.add_missed();
+      if (at - first_truth >= static_cast<std::int64_t>(options.compensation_s * 1e9)) {
+        lane.score.compensated.add_missed();
+        lane.score.after_calibration.add_missed();
+      }
+    }
+    if (options.trace) lane.score.trace.push_back(tp);
   }
-  return result;
+
+  void add(TimedSkeleton e) {
+    if (any_event && e.t_ns < last_event)
+      throw std::invalid_argument("evaluation: events out of time order (" + std::to_string(e.t_ns) + " ns after " +
+                                  std::to_string(last_event) + " ns)");
+    any_event = true;
+    last_event = e.t_ns;
+    ensure_lane(e);
+    if (e.kind == TimedSkeleton::Kind::Truth) {
+      truth.add(e.skeleton, e.t_ns);
+      if (!any_truth) first_truth = e.t_ns;
+      any_truth = true;
+      result.has_truth = true;
+    } else if (e.kind == TimedSkeleton::Kind::Raw) {
+      if (!any_raw) next_tick = e.t_ns;
+      any_raw = true;
+      last_raw = e.t_ns;
+    }
+    pending.push_back(std::move(e));
+    run_ticks(last_event - horizon_ns);
+  }
+
+  OfflineResult finish() {
+    if (any_raw) run_ticks(options.tick_times.empty() ? last_raw + options.period_ns : std::numeric_limits<std::int64_t>::max());
+    pending.clear();
+    // Singles first (sensor order), then methods, then recorded live fusion.
+    std::stable_sort(lanes.begin(), lanes.end(), [](const Lane& a, const Lane& b) { return a.kind < b.kind; });
+    OfflineResult r = std::move(result);
+    if (!any_raw) r.ticks = 0;
+    for (auto& lane : lanes) {
+      if (!any_raw) break;  // nothing to fuse: no streams
+      r.streams.push_back(std::move(lane.score));
+      r.fuser_stats.push_back(lane.fuser.stats());
+    }
+    lanes.clear();
+    return r;
+  }
+};
+
+Evaluator::Evaluator(std::map<std::string, Eigen::Isometry3d> world_from_sensor, const std::vector<std::string>& sensor_ids,
+                     const std::vector<std::string>& recorded_ids, OfflineOptions options, FusedSink sink,
+                     std::int64_t horizon_ns)
+    : impl_(std::make_unique<Impl>(std::move(world_from_sensor), std::move(options), std::move(sink), horizon_ns)) {
+  using Kind = Impl::Lane::Kind;
+  if (impl_->options.singles) {
+    for (const auto& id : sensor_ids) impl_->make_lane(Kind::Single, id, fusion::Method::Avg, id, "");
+  }
+  for (const auto m : impl_->options.methods) impl_->make_lane(Kind::Method, fusion::method_name(m), m, "", "");
+  for (const auto& id : recorded_ids) impl_->make_lane(Kind::Recorded, "live " + id, fusion::Method::Avg, "", id);
+}
+
+Evaluator::~Evaluator() = default;
+void Evaluator::add(TimedSkeleton event) { impl_->add(std::move(event)); }
+std::size_t Evaluator::pending() const { return impl_->pending.size(); }
+OfflineResult Evaluator::finish() { return impl_->finish(); }
+
+OfflineResult evaluate(const std::map<std::string, Eigen::Isometry3d>& world_from_sensor,
+                       const std::vector<TimedSkeleton>& events, const OfflineOptions& options,
+                       const FusedSink& sink) {
+  std::vector<std::string> sensor_ids, recorded_ids;
+  for (const auto& e : events) {
+    auto& ids = e.kind == TimedSkeleton::Kind::Raw ? sensor_ids : recorded_ids;
+    if (e.kind != TimedSkeleton::Kind::Truth && std::find(ids.begin(), ids.end(), e.skeleton.sensor_id) == ids.end()) {
+      ids.push_back(e.skeleton.sensor_id);
+    }
+  }
+  Evaluator ev(world_from_sensor, sensor_ids, recorded_ids, options, sink);
+  for (const auto& e : events) ev.add(e);
+  return ev.finish();
 }
 
 }  // namespace skelgraph::eval

@@ -58,6 +58,8 @@ class TruthTimeline {
   std::size_t people() const { return by_person_.size(); }
   // True when some person's truth covers t.
   bool covers(std::int64_t t_ns, std::int64_t max_gap_ns = 100'000'000) const;
+  // Drops the samples before t, keeping each person's last one before it (to interpolate from).
+  void forget_before(std::int64_t t_ns);
 
  private:
   std::map<std::uint32_t, std::vector<std::pair<std::int64_t, skeleton::Skeleton>>> by_person_;

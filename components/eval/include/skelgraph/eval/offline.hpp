@@ -10,6 +10,7 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -73,6 +74,36 @@ struct OfflineResult {
 
 // Called with every fused skeleton of every method (e.g. to write them to a recording).
 using FusedSink = std::function<void(fusion::Method, const skeleton::Skeleton&)>;
+
+// The evaluation one event at a time, for sessions too long to hold in
+// memory: events go in in time order and each output tick is fused and scored
+// once the events have run `horizon_ns` past it (the truth around a tick is
+// then known). Memory stays bounded: the events and truth of the last few
+// seconds, plus per-tick traces when asked for. The result is the same as
+// evaluate()'s on the whole list, except on ticks within 0.1 s after a
+// person's truth stops for longer than the horizon and later resumes.
+class Evaluator {
+ public:
+  // `sensor_ids`: the sensors scored alone, in output order; `recorded_ids`:
+  // the recorded live fusion streams. An id first seen later gets its
+  // stream then, scored from that tick on.
+  Evaluator(std::map<std::string, Eigen::Isometry3d> world_from_sensor, const std::vector<std::string>& sensor_ids,
+            const std::vector<std::string>& recorded_ids, OfflineOptions options, FusedSink sink = {},
+            std::int64_t horizon_ns = 2'000'000'000);
+  ~Evaluator();
+  Evaluator(const Evaluator&) = delete;
+  Evaluator& operator=(const Evaluator&) = delete;
+
+  // Throws std::invalid_argument for an event older than the one before it.
+  void add(TimedSkeleton event);
+  std::size_t pending() const;  // events held, waiting for their tick
+  // Fuses and scores the remaining ticks (to the last raw event + one period, or the last tick_time).
+  OfflineResult finish();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 // `events` in time order. Ticks run from the first raw event to the last at
 // `period_ns` (or are `tick_times`); a tick counts for accuracy when truth covers it.
