@@ -2,15 +2,17 @@
 // and every single sensor, scored against ground truth in the layout of the
 // thesis's Tables 5.1-5.4 (detection %, error cm per joint group). No DDS.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <algorithm>
 #include <limits>
 #include <map>
 #include <queue>
 #include <sstream>
+
+#include <unistd.h>
 
 #include <nlohmann/json.hpp>
 
@@ -263,9 +265,15 @@ void stream_recording(const RecordingInputs& in, eval::Evaluator& ev) {
   std::priority_queue<Held, std::vector<Held>, decltype(later)> held(later);
   std::uint64_t seq = 0;
   std::int64_t latest = std::numeric_limits<std::int64_t>::min();
+  // Progress on a terminal, for recordings that take a while (over ~10 minutes of two sensors).
+  const std::uint64_t total = in.raw + in.truth + in.fused;
+  const bool progress = total > 40'000 && isatty(fileno(stderr));
   try {
     const mcap::Reader reader(in.file);
     for_each_skeleton_message(reader, [&](eval::TimedSkeleton::Kind kind, std::int64_t t, skeleton::Skeleton s) {
+      if (progress && seq % 5000 == 0)
+        std::fprintf(stderr, "\r%s: %llu of %llu skeletons fused and scored (%.0f %%)   ", in.file.c_str(),
+                     static_cast<unsigned long long>(seq), static_cast<unsigned long long>(total), 100.0 * seq / total);
       latest = std::max(latest, t);
       held.push({{kind, t, std::move(s)}, seq++});
       while (!held.empty() && held.top().e.t_ns <= latest - in.lateness_ns) {
@@ -277,6 +285,7 @@ void stream_recording(const RecordingInputs& in, eval::Evaluator& ev) {
     throw UsageError(e.what());
   }
   for (; !held.empty(); held.pop()) ev.add(held.top().e);
+  if (progress) std::fprintf(stderr, "\r%*s\r", static_cast<int>(in.file.size()) + 60, "");
 }
 
 struct FileOptions {
