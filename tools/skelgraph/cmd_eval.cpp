@@ -5,6 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <deque>
+#include <functional>
+#include <optional>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -184,19 +187,17 @@ struct RecordingInputs {
   std::int64_t lateness_ns = 0;  // the most a skeleton's log time falls behind an earlier one's in the file
 };
 
-// Calls f(kind, log_time, message bytes) for every skeleton on the raw, truth and fused topics, in file order.
-template <typename F>
-void for_each_skeleton_message(const mcap::Reader& reader, F&& f) {
-  reader.for_each_message([&](const mcap::Channel& ch, const mcap::Schema* schema, const mcap::Message& m) {
-    if (schema == nullptr || schema->name != msg::MessageTraits<msg::Skeleton>::name) return;
-    const bool raw = ch.topic == runtime::topics::kSkeletonRaw.name;
-    const bool truth = ch.topic == runtime::topics::kSkeletonTruth.name;
-    const bool fused = ch.topic == runtime::topics::kSkeletonFused.name;
-    if (!raw && !truth && !fused) return;
-    f(raw ? eval::TimedSkeleton::Kind::Raw : truth ? eval::TimedSkeleton::Kind::Truth : eval::TimedSkeleton::Kind::Fused,
-      static_cast<std::int64_t>(m.log_time),
-      skeleton::from_msg(msg::from_cdr<msg::Skeleton>(reinterpret_cast<const std::uint8_t*>(m.data.data()), m.data.size())));
-  });
+// Which evaluated stream a channel carries (raw, truth, recorded live fusion), if any.
+std::optional<eval::TimedSkeleton::Kind> skeleton_kind(const mcap::Channel& ch, const mcap::Schema* schema) {
+  if (schema == nullptr || schema->name != msg::MessageTraits<msg::Skeleton>::name) return std::nullopt;
+  if (ch.topic == runtime::topics::kSkeletonRaw.name) return eval::TimedSkeleton::Kind::Raw;
+  if (ch.topic == runtime::topics::kSkeletonTruth.name) return eval::TimedSkeleton::Kind::Truth;
+  if (ch.topic == runtime::topics::kSkeletonFused.name) return eval::TimedSkeleton::Kind::Fused;
+  return std::nullopt;
+}
+
+skeleton::Skeleton skeleton_of(const mcap::Message& m) {
+  return skeleton::from_msg(msg::from_cdr<msg::Skeleton>(reinterpret_cast<const std::uint8_t*>(m.data.data()), m.data.size()));
 }
 
 // shared_frame: every sensor's skeletons are already in one frame (data sets
@@ -220,16 +221,20 @@ RecordingInputs read_recording(const std::string& file, bool shared_frame, const
       }
     });
     std::int64_t latest = std::numeric_limits<std::int64_t>::min();
-    for_each_skeleton_message(reader, [&](eval::TimedSkeleton::Kind kind, std::int64_t t, const skeleton::Skeleton& s) {
+    reader.for_each_message([&](const mcap::Channel& ch, const mcap::Schema* schema, const mcap::Message& m) {
+      const auto kind = skeleton_kind(ch, schema);
+      if (!kind) return;
+      const auto t = static_cast<std::int64_t>(m.log_time);
       if (latest != std::numeric_limits<std::int64_t>::min()) in.lateness_ns = std::max(in.lateness_ns, latest - t);
       latest = std::max(latest, t);
-      if (kind == eval::TimedSkeleton::Kind::Truth) {
+      if (*kind == eval::TimedSkeleton::Kind::Truth) {
         ++in.truth;
         return;
       }
-      auto& ids = kind == eval::TimedSkeleton::Kind::Raw ? in.sensor_ids : in.recorded_ids;
-      if (std::find(ids.begin(), ids.end(), s.sensor_id) == ids.end()) ids.push_back(s.sensor_id);
-      ++(kind == eval::TimedSkeleton::Kind::Raw ? in.raw : in.fused);
+      const auto id = skeleton_of(m).sensor_id;
+      auto& ids = *kind == eval::TimedSkeleton::Kind::Raw ? in.sensor_ids : in.recorded_ids;
+      if (std::find(ids.begin(), ids.end(), id) == ids.end()) ids.push_back(id);
+      ++(*kind == eval::TimedSkeleton::Kind::Raw ? in.raw : in.fused);
     });
   } catch (const mcap::McapError& e) {
     throw UsageError(e.what());
@@ -255,8 +260,10 @@ RecordingInputs read_recording(const std::string& file, bool shared_frame, const
 
 // The recording's skeletons into `ev` in time order (ties in file order): a
 // second pass, held back only as far as the file's own disorder (lateness_ns)
-// requires, so a long recording is never held whole.
-void stream_recording(const RecordingInputs& in, eval::Evaluator& ev) {
+// requires, so a long recording is never held whole. `each`, if given, sees
+// every message of the file in file order, after its skeleton went in.
+using MessageHook = std::function<void(const mcap::Channel&, const mcap::Message&)>;
+void stream_recording(const RecordingInputs& in, eval::Evaluator& ev, const MessageHook& each = {}) {
   struct Held {
     eval::TimedSkeleton e;
     std::uint64_t seq;
@@ -270,16 +277,20 @@ void stream_recording(const RecordingInputs& in, eval::Evaluator& ev) {
   const bool progress = total > 40'000 && isatty(fileno(stderr));
   try {
     const mcap::Reader reader(in.file);
-    for_each_skeleton_message(reader, [&](eval::TimedSkeleton::Kind kind, std::int64_t t, skeleton::Skeleton s) {
-      if (progress && seq % 5000 == 0)
-        std::fprintf(stderr, "\r%s: %llu of %llu skeletons fused and scored (%.0f %%)   ", in.file.c_str(),
-                     static_cast<unsigned long long>(seq), static_cast<unsigned long long>(total), 100.0 * seq / total);
-      latest = std::max(latest, t);
-      held.push({{kind, t, std::move(s)}, seq++});
-      while (!held.empty() && held.top().e.t_ns <= latest - in.lateness_ns) {
-        ev.add(held.top().e);
-        held.pop();
+    reader.for_each_message([&](const mcap::Channel& ch, const mcap::Schema* schema, const mcap::Message& m) {
+      if (const auto kind = skeleton_kind(ch, schema)) {
+        if (progress && seq % 5000 == 0)
+          std::fprintf(stderr, "\r%s: %llu of %llu skeletons fused and scored (%.0f %%)   ", in.file.c_str(),
+                       static_cast<unsigned long long>(seq), static_cast<unsigned long long>(total), 100.0 * seq / total);
+        const auto t = static_cast<std::int64_t>(m.log_time);
+        latest = std::max(latest, t);
+        held.push({{*kind, t, skeleton_of(m)}, seq++});
+        while (!held.empty() && held.top().e.t_ns <= latest - in.lateness_ns) {
+          ev.add(held.top().e);
+          held.pop();
+        }
       }
+      if (each) each(ch, m);
     });
   } catch (const mcap::McapError& e) {
     throw UsageError(e.what());
@@ -378,36 +389,53 @@ int fuse_file(const FileOptions& o) {
   const auto in = read_recording(o.file, o.shared_frame, o.calibration);
   auto eo = offline_options(o, in);
   eo.singles = false;  // only the methods go into the file
-  std::vector<std::pair<std::int64_t, skeleton::Skeleton>> fused;
-  // The fused output is held until it is merged into the copy (the input is streamed).
+  // One pass: every message is copied in file order, each after the fused
+  // skeletons up to its log time; a message waits only until the fusion has
+  // got that far (a few seconds), so neither side is held whole.
+  std::deque<std::pair<std::int64_t, skeleton::Skeleton>> fused;  // in time order, as the ticks make them
+  std::uint64_t fused_count = 0, copied = 0;
   eval::Evaluator ev(in.poses, in.sensor_ids, {}, eo, [&](fusion::Method m, const skeleton::Skeleton& s) {
     auto f = s;
     f.sensor_id = eo.methods.size() == 1 ? "fused" : std::string("fused_") + fusion::method_name(m);
     fused.emplace_back(s.stamp_ns + eo.fuser.delay_ns, std::move(f));
+    ++fused_count;
   });
-  stream_recording(in, ev);
-  const auto r = ev.finish();
-  std::stable_sort(fused.begin(), fused.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-  std::uint64_t copied = 0;
+  struct Copy {
+    std::string topic, type;
+    bool keyed;
+    std::string data;
+    std::uint64_t log_time, publish_time;
+  };
+  std::deque<Copy> copies;
+  eval::OfflineResult r;
   try {
-    const mcap::Reader reader(o.file);
     recording::BagWriter bag(o.out);
-    std::size_t next = 0;
-    const auto flush_until = [&](std::uint64_t t) {
-      for (; next < fused.size() && static_cast<std::uint64_t>(std::max<std::int64_t>(0, fused[next].first)) <= t; ++next) {
-        const auto at = static_cast<std::uint64_t>(std::max<std::int64_t>(0, fused[next].first));
-        bag.write(runtime::topics::kSkeletonFused.name, skeleton::to_msg(fused[next].second), at, at);
+    const auto fused_until = [&](std::uint64_t t) {
+      for (; !fused.empty() && static_cast<std::uint64_t>(std::max<std::int64_t>(0, fused.front().first)) <= t; fused.pop_front()) {
+        const auto at = static_cast<std::uint64_t>(std::max<std::int64_t>(0, fused.front().first));
+        bag.write(runtime::topics::kSkeletonFused.name, skeleton::to_msg(fused.front().second), at, at);
       }
     };
-    reader.for_each_message([&](const mcap::Channel& ch, const mcap::Schema*, const mcap::Message& m) {
+    const auto copy_until = [&](std::int64_t done) {
+      for (; !copies.empty() && (done == std::numeric_limits<std::int64_t>::max() ||
+                                 (done >= 0 && copies.front().log_time <= static_cast<std::uint64_t>(done)));
+           copies.pop_front()) {
+        const auto& c = copies.front();
+        fused_until(c.log_time);
+        bag.write_cdr(c.topic, c.type, c.keyed, c.data, c.log_time, c.publish_time);
+        ++copied;
+      }
+    };
+    stream_recording(in, ev, [&](const mcap::Channel& ch, const mcap::Message& m) {
       if (ch.topic == runtime::topics::kSkeletonFused.name) return;  // replaced
-      flush_until(m.log_time);
       const auto type = ch.metadata.count("dds_type") ? ch.metadata.at("dds_type") : std::string();
       const bool keyed = ch.metadata.count("keyed") && ch.metadata.at("keyed") == "true";
-      bag.write_cdr(ch.topic, type, keyed, m.data, m.log_time, m.publish_time);
-      ++copied;
+      copies.push_back({ch.topic, type, keyed, std::string(m.data.begin(), m.data.end()), m.log_time, m.publish_time});
+      copy_until(ev.done_until());
     });
-    flush_until(UINT64_MAX);
+    r = ev.finish();
+    copy_until(std::numeric_limits<std::int64_t>::max());
+    fused_until(UINT64_MAX);
     bag.close();
   } catch (const mcap::McapError& e) {
     throw UsageError(e.what());
@@ -419,13 +447,14 @@ int fuse_file(const FileOptions& o) {
                               {"gated", r.fuser_stats[i].gated}};
   }
   if (o.json) {
-    std::printf("%s\n", nlohmann::json{{"in", o.file}, {"out", o.out}, {"copied", copied}, {"fused", fused.size()},
+    std::printf("%s\n", nlohmann::json{{"in", o.file}, {"out", o.out}, {"copied", copied}, {"fused", fused_count},
                                        {"on_sync_ticks", !in.ticks.empty()},
                                        {"ticks", r.ticks}, {"methods", per}}
                             .dump(2)
                             .c_str());
   } else {
-    std::printf("%s: %zu fused skeletons (%s) added to %llu messages of %s\n", o.out.c_str(), fused.size(),
+    std::printf("%s: %llu fused skeletons (%s) added to %llu messages of %s\n", o.out.c_str(),
+                static_cast<unsigned long long>(fused_count),
                 per.dump().c_str(), static_cast<unsigned long long>(copied), o.file.c_str());
   }
   return 0;

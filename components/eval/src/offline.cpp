@@ -107,6 +107,7 @@ struct Evaluator::Impl {
   TruthTimeline truth;
   OfflineResult result;
   std::int64_t first_truth = 0, last_event = 0, last_raw = 0, next_tick = 0;
+  std::int64_t done_until = std::numeric_limits<std::int64_t>::min();
   bool any_truth = false, any_raw = false, any_event = false;
   std::size_t next_tick_index = 0;  // into options.tick_times
 
@@ -154,6 +155,7 @@ struct Evaluator::Impl {
   void run_ticks(std::int64_t limit) {
     while (const auto tick = tick_before(limit)) {
       run_tick(*tick);
+      done_until = *tick;
       advance_tick();
     }
   }
@@ -315,6 +317,7 @@ Evaluator::Evaluator(std::map<std::string, Eigen::Isometry3d> world_from_sensor,
 Evaluator::~Evaluator() = default;
 void Evaluator::add(TimedSkeleton event) { impl_->add(std::move(event)); }
 std::size_t Evaluator::pending() const { return impl_->pending.size(); }
+std::int64_t Evaluator::done_until() const { return impl_->done_until; }
 OfflineResult Evaluator::finish() { return impl_->finish(); }
 
 OfflineResult evaluate(const std::map<std::string, Eigen::Isometry3d>& world_from_sensor,

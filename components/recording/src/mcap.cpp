@@ -140,9 +140,10 @@ class In {
   std::uint64_t pos_ = 0;
 };
 
-std::string compress(Compression c, const std::string& raw) {
+// Compresses into `out` (its capacity is kept from chunk to chunk); returns the
+// packed bytes: `raw` itself without compression.
+std::string_view compress(Compression c, const std::string& raw, std::string& out) {
   if (c == Compression::None) return raw;
-  std::string out;
   if (c == Compression::Lz4) {
     out.resize(LZ4F_compressFrameBound(raw.size(), nullptr));
     const auto n = LZ4F_compressFrame(out.data(), out.size(), raw.data(), raw.size(), nullptr);
@@ -275,9 +276,14 @@ void Writer::put(const void* data, std::size_t n) {
   offset_ += n;
 }
 
-void Writer::write_record(std::uint8_t op, const std::string& body) {
-  const auto r = record(op, body);
-  put(r.data(), r.size());
+void Writer::write_record(std::uint8_t op, std::string_view body, std::string_view tail) {
+  // Opcode and length, then the body as it is: no copy of a megabyte chunk per record.
+  Out h;
+  h.u8(op);
+  h.u64(body.size() + tail.size());
+  put(h.s.data(), h.s.size());
+  put(body.data(), body.size());
+  if (!tail.empty()) put(tail.data(), tail.size());
 }
 
 std::uint16_t Writer::add_schema(const std::string& name, const std::string& encoding, const std::string& data) {
@@ -335,7 +341,7 @@ void Writer::write(const Message& m) {
 
 void Writer::close_chunk() {
   if (chunk_.empty()) return;
-  const std::string packed = compress(opt_.compression, chunk_);
+  const std::string_view packed = compress(opt_.compression, chunk_, packed_);
   ChunkIndex ci;
   ci.start_time = chunk_has_messages_ ? chunk_start_ : 0;
   ci.end_time = chunk_has_messages_ ? chunk_end_ : 0;
@@ -349,8 +355,8 @@ void Writer::close_chunk() {
   o.u64(chunk_.size());
   o.u32(crc32_of(chunk_));
   o.str(ci.compression);
-  o.bytes64(packed);
-  write_record(kChunk, o.s);
+  o.u64(packed.size());
+  write_record(kChunk, o.s, packed);  // the packed records follow the chunk's header fields
   ci.length = offset_ - ci.offset;
   const std::uint64_t index_start = offset_;
   for (const auto& [channel, entries] : chunk_message_index_) {

@@ -97,6 +97,9 @@ class Evaluator {
   // Throws std::invalid_argument for an event older than the one before it.
   void add(TimedSkeleton event);
   std::size_t pending() const;  // events held, waiting for their tick
+  // The last tick fused and scored so far (every FusedSink call up to it has
+  // been made); the lowest int64 before the first.
+  std::int64_t done_until() const;
   // Fuses and scores the remaining ticks (to the last raw event + one period, or the last tick_time).
   OfflineResult finish();
 

@@ -97,7 +97,7 @@ class Writer {
  private:
   struct ChunkIndex;
   void put(const void* data, std::size_t n);  // to the file, counting and CRC'ing
-  void write_record(std::uint8_t op, const std::string& body);
+  void write_record(std::uint8_t op, std::string_view body, std::string_view tail = {});
   void close_chunk();
 
   std::string path_;
@@ -108,7 +108,8 @@ class Writer {
   bool in_summary_ = false;
   std::vector<Schema> schemas_;
   std::vector<Channel> channels_;
-  std::string chunk_;  // uncompressed records of the open chunk
+  std::string chunk_;   // uncompressed records of the open chunk
+  std::string packed_;  // the chunk compressed (kept: no fresh megabyte per chunk)
   std::map<std::uint16_t, std::vector<std::pair<std::uint64_t, std::uint64_t>>> chunk_message_index_;
   std::uint64_t chunk_start_ = 0, chunk_end_ = 0;
   bool chunk_has_messages_ = false;
