@@ -6,12 +6,12 @@
 #include <cmath>
 #include <cstdio>
 #include <deque>
-#include <functional>
-#include <optional>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <map>
+#include <optional>
 #include <queue>
 #include <sstream>
 
@@ -177,7 +177,7 @@ std::string write_report_page(const std::string& dir, const std::string& heading
 
 // What a recording holds for evaluation, from a first pass over it: sensor
 // poses (the latest per sensor in the file), sync ticks, counts, and the ids
-// of the streams. The skeletons themselves are streamed by for_each_event.
+// of the streams. The skeletons themselves are streamed by stream_recording.
 struct RecordingInputs {
   std::string file;
   std::map<std::string, Eigen::Isometry3d> poses;
@@ -208,6 +208,7 @@ RecordingInputs read_recording(const std::string& file, bool shared_frame, const
   in.file = file;
   try {
     const mcap::Reader reader(file);
+    std::int64_t latest = std::numeric_limits<std::int64_t>::min();
     reader.for_each_message([&](const mcap::Channel& ch, const mcap::Schema* schema, const mcap::Message& m) {
       if (schema == nullptr) return;
       const auto* bytes = reinterpret_cast<const std::uint8_t*>(m.data.data());
@@ -219,9 +220,6 @@ RecordingInputs read_recording(const std::string& file, bool shared_frame, const
           in.ticks.push_back(static_cast<std::int64_t>(m.log_time));
         }
       }
-    });
-    std::int64_t latest = std::numeric_limits<std::int64_t>::min();
-    reader.for_each_message([&](const mcap::Channel& ch, const mcap::Schema* schema, const mcap::Message& m) {
       const auto kind = skeleton_kind(ch, schema);
       if (!kind) return;
       const auto t = static_cast<std::int64_t>(m.log_time);

@@ -3,10 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
-#include <stdexcept>
-#include <string>
 #include <limits>
 #include <optional>
+#include <stdexcept>
+#include <string>
 
 namespace skelgraph::eval {
 
