@@ -4,8 +4,9 @@
 # network namespace, records every gesture event and the ground-truth
 # skeletons over DDS with `skelgraph topic echo`, and scores each pointing
 # event's floor target against where the true shoulder -> hand ray of the
-# same arm meets the floor at the event's stamp. JSON on stdout: per event
-# the error, and the median. Needs root for `unshare -n`.
+# same arm met the floor while that arm was held still near the event's
+# stamp. JSON on stdout: per event the error, and the median. Needs root for
+# `unshare -n`.
 # Usage: bench/gesture_live.sh BUILD_DIR [SECONDS]
 set -euo pipefail
 build=${1:?usage: gesture_live.sh BUILD_DIR [SECONDS]}
@@ -37,14 +38,36 @@ out, errors = [], []
 for e in events:
     row = {"label": e["label"], "arm": e["arm"], "confidence": e["confidence"], "has_target": e["has_target"]}
     if e["label"] == "point" and e["has_target"] and truth:
+        # The true target is where the true arm pointed while it was held
+        # still (hand slower than 5 cm/s) within 2 s of the event's stamp;
+        # an event sent early or as the arm starts back down is scored
+        # against the hold, not against a moving arm.
         i = min(range(len(stamps)), key=lambda k: abs(stamps[k] - e["end_stamp_ns"]))
-        sh, ha = joint(truth[i], e["arm"] + "_shoulder"), joint(truth[i], e["arm"] + "_hand")
-        d = [b - a for a, b in zip(sh, ha)]
-        if d[1] < 0:
-            k = -sh[1] / d[1]
-            tt = [a + k * b for a, b in zip(sh, d)]
+        def ray_hit(k):
+            sh, ha = joint(truth[k], e["arm"] + "_shoulder"), joint(truth[k], e["arm"] + "_hand")
+            d = [b - a for a, b in zip(sh, ha)]
+            return [a + (-sh[1] / d[1]) * b for a, b in zip(sh, d)] if d[1] < 0 else None, d
+        def held(k):
+            if k < 1 or k >= len(truth) or stamps[k] <= stamps[k - 1]:
+                return False
+            ha, ha0 = joint(truth[k], e["arm"] + "_hand"), joint(truth[k - 1], e["arm"] + "_hand")
+            hit, d = ray_hit(k)
+            speed = math.dist(ha, ha0) / ((stamps[k] - stamps[k - 1]) * 1e-9)
+            return hit is not None and speed < 0.05 and -d[1] < 0.9 * math.hypot(*d)  # still, down, not hanging
+        # the run of held frames nearest the stamp (within 2 s)
+        near = next((k for r in range(61) for k in (i - r, i + r) if held(k)), None)
+        hits = []
+        if near is not None:
+            a = b = near
+            while held(a - 1): a -= 1
+            while held(b + 1): b += 1
+            hits = [ray_hit(k)[0] for k in range(a, b + 1)]
+        elif ray_hit(i)[0] is not None:
+            hits = [ray_hit(i)[0]]
+        if hits:
+            tt = [statistics.median(h[c] for h in hits) for c in range(3)]
             err = math.dist(tt, [e["target"]["x"], e["target"]["y"], e["target"]["z"]])
-            row.update(true_target=tt, target=[e["target"][c] for c in "xyz"], error_m=err)
+            row.update(true_target=tt, target=[e["target"][c] for c in "xyz"], error_m=err, held_frames=len(hits))
             errors.append(err)
     out.append(row)
 print(json.dumps({"seconds": seconds, "events": len(events), "scored": len(errors),
