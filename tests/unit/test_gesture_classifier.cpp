@@ -335,7 +335,7 @@ TEST(Metrics, MatchHandCountedValues) {
 
 TEST(Classifier, SavesAndLoadsAndRefusesMalformedFiles) {
   auto model = Classifier::train(synthetic_clips(8, 3), three_classes(), small_options());
-  model.set_pointing_correction({3.5, -1.25});
+  model.set_pointing_correction({3.5, -1.25, Eigen::Vector3d(0.02, 0.03, 0.01), Eigen::Vector3d(0.0, 0.06, 0.07)});
   const auto path = write_temp("model.json", "");
   model.save(path);
   const auto back = Classifier::load(path);
@@ -344,6 +344,8 @@ TEST(Classifier, SavesAndLoadsAndRefusesMalformedFiles) {
   EXPECT_EQ(back.hands(), model.hands());
   EXPECT_EQ(back.pointing_correction().elevation, 3.5);
   EXPECT_EQ(back.pointing_correction().azimuth_out, -1.25);
+  EXPECT_EQ(back.pointing_correction().shoulder, Eigen::Vector3d(0.02, 0.03, 0.01));
+  EXPECT_EQ(back.pointing_correction().hand, Eigen::Vector3d(0.0, 0.06, 0.07));
   std::mt19937_64 rng(9);
   for (int k = 0; k < 3; ++k) {
     const auto x = synthetic(k, rng);
@@ -360,6 +362,14 @@ TEST(Classifier, SavesAndLoadsAndRefusesMalformedFiles) {
   j = model.to_json();
   j["pointing_correction"] = {{"elevation_deg", "up"}};
   EXPECT_NE(error_of([&] { Classifier::from_json(j); }).find("'pointing_correction' must be"), std::string::npos);
+  j = model.to_json();
+  j["pointing_correction"]["hand_offset_m"] = {0.0, 0.06};
+  EXPECT_NE(error_of([&] { Classifier::from_json(j); }).find("'pointing_correction.hand_offset_m' must be [out, up, forward]"),
+            std::string::npos);
+  j = model.to_json();
+  j["pointing_correction"].erase("shoulder_offset_m");  // a model from before the joint offsets: none
+  j["pointing_correction"].erase("hand_offset_m");
+  EXPECT_EQ(Classifier::from_json(j).pointing_correction().hand, Eigen::Vector3d::Zero());
   j = model.to_json();
   j["version"] = 2;
   EXPECT_NE(error_of([&] { Classifier::from_json(j); }).find("unsupported 'version'"), std::string::npos);

@@ -65,11 +65,11 @@ Section pointing_section() {
   std::snprintf(head, sizeof head,
                 "<h2>Pointing (gesture spotting on the fused stream)</h2>\n<p>A classifier trained on 8 simulated "
                 "sessions of the point scenario spots pointing in 4 others it never saw: precision %.2f, recall %.2f, "
-                "F1 %.2f; decided a median %.0f ms after the arm came to rest pointing; the ray meets the floor a median "
+                "F1 %.2f; sent a median %.0f ms after the arm came to rest pointing (the ray gathered over the hold); the ray meets the floor a median "
                 "%.1f cm from the true target (ray direction %.1f&deg; off).</p>\n",
                 r.precision, r.recall, r.f1, 1e3 * r.median_latency_hold_s, 100 * r.median_target_error_m, r.median_ray_error_deg);
   s.html = std::string(head) +
-           "<table><tr><th>session</th><th>gesture at (s)</th><th>true target x, z (m)</th><th>decided after the hold "
+           "<table><tr><th>session</th><th>gesture at (s)</th><th>true target x, z (m)</th><th>sent after the hold "
            "began</th><th>spotted target x, z (m)</th><th>error</th></tr>\n" +
            rows + "</table>\n";
   return s;
@@ -177,7 +177,7 @@ int run_demo(const DemoOptions& o, GlobalOptions& g) {
                     s["upper_body_complete_pct"].get<double>());
       }
       const auto& p = out["pointing"];
-      std::printf("pointing in held-out simulated sessions: F1 %.2f (%d of %d found, %d false), decided %.0f ms after the "
+      std::printf("pointing in held-out simulated sessions: F1 %.2f (%d of %d found, %d false), sent %.0f ms after the "
                   "hold began, floor target %.1f cm from the true one (median)\n",
                   p["f1"].get<double>(), p["true_positive"].get<int>(), p["truth"].get<int>(), p["false_positive"].get<int>(),
                   1e3 * p["median_latency_from_hold_s"].get<double>(), 100 * p["median_target_error_m"].get<double>());

@@ -542,7 +542,7 @@ int gesture_sim(const GestureOptions& o) {
   };
   std::size_t clips = 0;
   const auto model = train_on_sim(o.train_sessions, o.seed, c, &clips,
-                                  [&](int d, int t) { progress("simulating and fusing training sessions", d, t); });
+                                  [&](int d, int t) { progress("simulating and fusing training sessions", d, t); }, o.spot);
   if (!o.out.empty()) model.save(o.out);
   const auto test = held_out_sessions(o.test_sessions, o.seed, [&](int d, int t) { progress("simulating and fusing test sessions", d, t); });
   const auto spotted = spot_sessions(model, test, o.spot);
@@ -585,6 +585,11 @@ int gesture_sim(const GestureOptions& o) {
                                         {"model", o.out},
                                         {"pointing_correction_deg", {{"elevation", model.pointing_correction().elevation},
                                                                      {"azimuth_out", model.pointing_correction().azimuth_out}}},
+                                        {"pointing_joint_offsets_m",
+                                         {{"shoulder", {model.pointing_correction().shoulder.x(), model.pointing_correction().shoulder.y(),
+                                                        model.pointing_correction().shoulder.z()}},
+                                          {"hand", {model.pointing_correction().hand.x(), model.pointing_correction().hand.y(),
+                                                    model.pointing_correction().hand.z()}}}},
                                         {"spotting", to_json(r)},
                                         {"sessions", per},
                                         {"events", ev}}
@@ -595,8 +600,11 @@ int gesture_sim(const GestureOptions& o) {
   std::printf("trained on %zu clips of %d simulated sessions%s; spotted on %d others:\n", clips, o.train_sessions,
               o.out.empty() ? "" : (" (model: " + o.out + ")").c_str(), o.test_sessions);
   std::printf("pointing: %d true, %d events: precision %.3f recall %.3f F1 %.3f\n", r.truth, r.events, r.precision, r.recall, r.f1);
-  std::printf("pointing correction learnt on the training sessions: rays lowered %.1f deg, turned in %.1f deg\n",
-              model.pointing_correction().elevation, model.pointing_correction().azimuth_out);
+  const auto& pc = model.pointing_correction();
+  std::printf("pointing correction learnt on the training sessions: shoulder off by (%.1f, %.1f, %.1f) cm and hand by "
+              "(%.1f, %.1f, %.1f) cm (out, up, forward); then rays lowered %.1f deg, turned in %.1f deg\n",
+              100 * pc.shoulder.x(), 100 * pc.shoulder.y(), 100 * pc.shoulder.z(), 100 * pc.hand.x(), 100 * pc.hand.y(),
+              100 * pc.hand.z(), pc.elevation, pc.azimuth_out);
   std::printf("latency: median %.0f ms after the hold began, %.0f ms from the end of the gesture (negative: before)\n",
               1e3 * r.median_latency_hold_s, 1e3 * r.median_latency_s);
   if (!r.target_error_m.empty())
@@ -682,6 +690,10 @@ void add_gesture_command(CLI::App& app, GlobalOptions&, Action& run) {
       ->check(CLI::Range(0.0, 10.0));
   sp->add_option("--gap", o->gap, "s of the last frame held between clips (default 0: the clips' own idle starts and ends are the rest)")->check(CLI::Range(0.0, 10.0));
   sp->add_option("--hold", o->spot.hold, "s an extended arm is held before pointing is tried (default 0.25)")->check(CLI::Range(0.0, 5.0));
+  sp->add_option("--aim", o->spot.aim,
+                 "s of the hold the pointing ray is averaged over, at most: the event goes out when the arm moves again or then "
+                 "(default 1.5; at most --hold: at once, from a --hold look)")
+      ->check(CLI::Range(0.0, 10.0));
   sp->add_option("--still-speed", o->spot.still_speed, "m/s below which a hand is still (default 0.25)")->check(CLI::Range(0.01, 5.0));
   sp->callback([o, &run] { run = [o] { return gesture_spot(*o); }; });
 
@@ -693,6 +705,10 @@ void add_gesture_command(CLI::App& app, GlobalOptions&, Action& run) {
   sm->add_option("--test-sessions", o->test_sessions, "sessions to spot on (default 4)")->check(CLI::Range(1, 200));
   sm->add_option("--out", o->out, "write the trained classifier (JSON), e.g. for the gesture component");
   sm->add_option("--hold", o->spot.hold, "s an extended arm is held before pointing is tried (default 0.25)")->check(CLI::Range(0.0, 5.0));
+  sm->add_option("--aim", o->spot.aim,
+                 "s of the hold the pointing ray is averaged over, at most: the event goes out when the arm moves again or then "
+                 "(default 1.5; at most --hold: at once, from a --hold look)")
+      ->check(CLI::Range(0.0, 10.0));
   sm->add_option("--still-speed", o->spot.still_speed, "m/s below which a hand is still (default 0.25)")->check(CLI::Range(0.01, 5.0));
   sm->add_option("--window", o->spot.window, "s over which hand speed is measured (default 0.25)")->check(CLI::Range(0.03, 2.0));
   sm->callback([o, &run] { run = [o] { return gesture_sim(*o); }; });

@@ -290,7 +290,11 @@ nlohmann::json Classifier::to_json() const {
           {"features", feature_set_name(features_)},
           {"hands", hands_name(hands_)},
           {"trimmed", trimmed_},
-          {"pointing_correction", {{"elevation_deg", pointing_.elevation}, {"azimuth_out_deg", pointing_.azimuth_out}}},
+          {"pointing_correction",
+           {{"elevation_deg", pointing_.elevation},
+            {"azimuth_out_deg", pointing_.azimuth_out},
+            {"shoulder_offset_m", {pointing_.shoulder.x(), pointing_.shoulder.y(), pointing_.shoulder.z()}},
+            {"hand_offset_m", {pointing_.hand.x(), pointing_.hand.y(), pointing_.hand.z()}}}},
           {"models", models}};
 }
 
@@ -322,7 +326,15 @@ Classifier Classifier::from_json(const nlohmann::json& j) {
     if (!p.is_object() || !p.contains("elevation_deg") || !p["elevation_deg"].is_number() || !p.contains("azimuth_out_deg") ||
         !p["azimuth_out_deg"].is_number())
       throw ModelError("classifier: 'pointing_correction' must be {elevation_deg: number, azimuth_out_deg: number}");
-    c.pointing_ = {p["elevation_deg"].get<double>(), p["azimuth_out_deg"].get<double>()};
+    c.pointing_.elevation = p["elevation_deg"].get<double>();
+    c.pointing_.azimuth_out = p["azimuth_out_deg"].get<double>();
+    for (const auto& [key, out] : {std::pair{"shoulder_offset_m", &c.pointing_.shoulder}, {"hand_offset_m", &c.pointing_.hand}}) {
+      if (!p.contains(key)) continue;  // models written before the joint offsets: none
+      const auto& v = p[key];
+      if (!v.is_array() || v.size() != 3 || !v[0].is_number() || !v[1].is_number() || !v[2].is_number())
+        throw ModelError(std::string("classifier: 'pointing_correction.") + key + "' must be [out, up, forward] in metres");
+      *out = Eigen::Vector3d(v[0].get<double>(), v[1].get<double>(), v[2].get<double>());
+    }
   }
   const int K = static_cast<int>(c.labels_.size());
   if (c.garbage_ < -1 || c.garbage_ >= K) throw ModelError("classifier: 'garbage' is not a label index or -1");

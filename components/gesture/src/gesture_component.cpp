@@ -58,6 +58,10 @@ runtime::ComponentInfo GestureComponent::describe() {
                        "where pointing rays may land: 'name:x,y,z' (horizontal plane through the point) or "
                        "'name:x,y,z:nx,ny,nz'; the nearest hit wins")
       .add_double("hold_s", 0.25, "an extended arm held still this long is tried as pointing", 0.0, 5.0)
+      .add_double("aim_s", 1.5,
+                  "the pointing ray is averaged over the hold for up to this long; the event goes out when the arm moves "
+                  "again or then (at most hold_s: at once)",
+                  0.0, 10.0)
       .add_double("still_speed", 0.25, "a hand slower than this is still, m/s", 0.01, 5.0)
       .add_double("person_timeout_ms", 2000.0, "a person not seen this long is forgotten", 10.0, 60000.0);
   return info;
@@ -73,6 +77,7 @@ GestureComponent::GestureComponent(runtime::Context& ctx, const runtime::Params&
            [this](const msg::Skeleton& m, const runtime::SampleMeta& meta) { on_skeleton(skeleton::from_msg(m), meta.receive_ns); }) {
   options_.point_label = params.get<std::string>("point_label");
   options_.hold = params.get<double>("hold_s");
+  options_.aim = params.get<double>("aim_s");
   options_.still_speed = params.get<double>("still_speed");
   options_.surfaces.clear();
   // On a command line a list is split at commas, which also splits "name:x,y,z":

@@ -91,7 +91,44 @@ SimSession simulate_session(std::uint64_t seed, const Surface& floor) {
     out.truth.push_back(g);
     i = j;
   }
+  // The hold frames with the fused skeleton of the same moment (the fused
+  // person nearest the truth: a tracker's brief ghost twin is another id).
+  std::size_t f = 0;
+  for (const auto& tf : truth) {
+    if (tf.phase.rfind("hold:", 0) != 0) continue;
+    while (f < out.fused.size() && out.fused[f].stamp_ns < tf.t - 20'000'000) ++f;
+    const skeleton::Skeleton* best = nullptr;
+    double best_d = 0.3;
+    for (std::size_t k = f; k < out.fused.size() && out.fused[k].stamp_ns <= tf.t + 20'000'000; ++k) {
+      const double d = (out.fused[k][JointId::Torso].position - tf.s[JointId::Torso].position).norm();
+      if (d < best_d) best_d = d, best = &out.fused[k];
+    }
+    if (best) out.holds.push_back({*best, tf.s, tf.phase == "hold:right"});
+  }
   return out;
+}
+
+void learn_joint_offsets(const std::vector<SimSession>& sessions, PointingCorrection& c) {
+  std::vector<double> d[2][3];  // [shoulder, hand][out, up, forward]
+  for (const auto& s : sessions)
+    for (const auto& h : s.holds) {
+      const JointId sh = h.right ? JointId::RightShoulder : JointId::LeftShoulder;
+      const JointId ha = h.right ? JointId::RightHand : JointId::LeftHand;
+      const auto& l = h.fused[JointId::LeftShoulder];
+      const auto& r = h.fused[JointId::RightShoulder];
+      if (l.confidence < skeleton::kTracked || r.confidence < skeleton::kTracked || h.fused[sh].confidence < skeleton::kTracked ||
+          h.fused[ha].confidence < skeleton::kTracked)
+        continue;
+      const ArmFrame arm(r.position - l.position, h.right);
+      const Vector3d a = arm.to_body(h.fused[sh].position - h.truth[sh].position);
+      const Vector3d b = arm.to_body(h.fused[ha].position - h.truth[ha].position);
+      for (int k = 0; k < 3; ++k) d[0][k].push_back(a[k]), d[1][k].push_back(b[k]);
+    }
+  if (d[0][0].empty()) return;
+  for (int k = 0; k < 3; ++k) {
+    c.shoulder[k] = median(d[0][k]);
+    c.hand[k] = median(d[1][k]);
+  }
 }
 
 ClassMap sim_class_map() {
@@ -163,7 +200,7 @@ ClassifierOptions sim_classifier_options() {
 }
 
 Classifier train_on_sim(int sessions, std::uint64_t seed, const ClassifierOptions& options, std::size_t* clips,
-                        const std::function<void(int, int)>& progress) {
+                        const std::function<void(int, int)>& progress, const SpotterOptions& spot) {
   std::vector<SimSession> train;
   for (int i = 0; i < sessions; ++i) {
     train.push_back(simulate_session(seed * 1000 + static_cast<std::uint64_t>(i)));
@@ -173,9 +210,13 @@ Classifier train_on_sim(int sessions, std::uint64_t seed, const ClassifierOption
   const auto c = session_clips(train, map, options.features.set);
   if (clips) *clips = c.size();
   auto model = Classifier::train(c, map, options);
-  // The pointing correction: the median angles by which the spotted rays miss the true ones.
+  // The pointing correction: first the joints' offsets, then the median
+  // angles by which the rays spotted from the corrected joints still miss the true ones.
+  PointingCorrection pc;
+  learn_joint_offsets(train, pc);
+  model.set_pointing_correction(pc);
   std::vector<double> el, az;
-  const auto spotted = spot_sessions(model, train);
+  const auto spotted = spot_sessions(model, train, spot);
   for (std::size_t n = 0; n < train.size(); ++n)
     for (const auto& e : spotted[n].events) {
       if (!e.has_ray) continue;
@@ -187,7 +228,11 @@ Classifier train_on_sim(int sessions, std::uint64_t seed, const ClassifierOption
           break;
         }
     }
-  if (!el.empty()) model.set_pointing_correction({median(el), median(az)});
+  if (!el.empty()) {
+    pc.elevation = median(el);
+    pc.azimuth_out = median(az);
+    model.set_pointing_correction(pc);
+  }
   return model;
 }
 

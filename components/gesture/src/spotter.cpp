@@ -79,6 +79,13 @@ Surface parse_surface(const std::string& text) {
   return s;
 }
 
+ArmFrame::ArmFrame(const Vector3d& across, bool right) : up(Vector3d::UnitY()) {
+  Vector3d a(across.x(), 0, across.z());
+  a = a.norm() > 1e-9 ? a.normalized() : Vector3d::UnitX();
+  out = right ? a : Vector3d(-a);
+  forward = Vector3d(-a).cross(up);  // left x up: the way the torso faces
+}
+
 Vector3d corrected(const Vector3d& direction, const Vector3d& out, const PointingCorrection& c) {
   if (out.norm() < 1e-9) return direction;
   const Vector3d o = Vector3d(out.x(), 0, out.z()).normalized();
@@ -109,6 +116,24 @@ std::vector<SpottedEvent> Spotter::step(const skeleton::Skeleton& s, const Wrist
   std::vector<SpottedEvent> out;
   person_ = s.person_id;
   const std::int64_t t = s.stamp_ns;
+  if (first_ns_ < 0) first_ns_ = t;
+  // The pointing event gathered over the hold goes out: at `aim` (moving:
+  // false), or when the arm moves again, without the hold's last `window` s,
+  // when the hand was already on its way (the speed is measured over that
+  // window, so it says "moving" that late). Stamped with its last sample
+  // (or when it was decided, if that was later).
+  const auto send_aimed = [&](int side, bool moving) {
+    if (!aiming_ || aiming_side_ != side) return;
+    auto& rays = rays_[side];
+    const auto cut = t - static_cast<std::int64_t>(o_.window * 1e9);
+    if (moving) {
+      while (rays.size() > 1 && rays.back().t > cut) rays.pop_back();
+    }
+    aim(*aiming_, rays, side);
+    if (!rays.empty()) aiming_->end_ns = std::max(aiming_->end_ns, rays.back().t);
+    out.push_back(std::move(*aiming_));
+    aiming_.reset();
+  };
   const double dt = have_last_ && t > last_ns_ ? static_cast<double>(t - last_ns_) * 1e-9 : 1.0 / 30;
   const Eigen::VectorXd x = features_.step(s, nullptr, nullptr, wrists);
 
@@ -124,6 +149,7 @@ std::vector<SpottedEvent> Spotter::step(const skeleton::Skeleton& s, const Wrist
     const bool good = s[j[0]].confidence >= skeleton::kTracked && s[j[1]].confidence >= skeleton::kTracked &&
                       s[j[2]].confidence >= skeleton::kTracked;
     if (!good) {  // no evidence: counts as at rest and still, ends any hold
+      send_aimed(side, true);
       at_rest[side] = still[side] = true;
       hold_since_[side] = -1;
       rays_[side].clear();
@@ -145,15 +171,21 @@ std::vector<SpottedEvent> Spotter::step(const skeleton::Skeleton& s, const Wrist
     reach.y() = 0;
     at_rest[side] = ha.y() < sh.y() - o_.rest_drop * len && reach.norm() < o_.rest_reach * len;
     still[side] = speed_[side] < o_.still_speed;
-    const bool extended = !at_rest[side] && (ha - sh).norm() >= o_.extended * len;
+    const bool settled = static_cast<double>(t - first_ns_) * 1e-9 >= o_.warmup;
+    const bool extended = settled && !at_rest[side] && (ha - sh).norm() >= o_.extended * len;
     if (still[side] && extended) {
       if (hold_since_[side] < 0) {
         hold_since_[side] = t;
         rays_[side].clear();
       }
-      rays_[side].emplace_back(sh, (ha - sh).normalized());
+      const ArmFrame arm(across_, side == 1);
+      const auto& pc = c_.pointing_correction();
+      const Vector3d sh0 = sh - arm.to_world(pc.shoulder), ha0 = ha - arm.to_world(pc.hand);
+      rays_[side].push_back({t, sh0, (ha0 - sh0).normalized()});
+      if (aiming_ && aiming_side_ == side && static_cast<double>(t - hold_since_[side]) * 1e-9 >= o_.aim) send_aimed(side, false);
       if (rays_[side].size() > best_rays_.size()) best_rays_ = rays_[side], best_side_ = side;
     } else {
+      send_aimed(side, true);
       hold_since_[side] = -1;
       rays_[side].clear();
     }
@@ -185,7 +217,12 @@ std::vector<SpottedEvent> Spotter::step(const skeleton::Skeleton& s, const Wrist
     for (int side = 0; side < 2; ++side) {
       if (hold_since_[side] < 0 || static_cast<double>(t - hold_since_[side]) * 1e-9 < o_.hold) continue;
       if (auto e = decide(t, true)) {
-        out.push_back(*e);
+        if (o_.aim > o_.hold) {  // decided; the ray is gathered until the arm moves or `aim` has passed
+          aiming_side_ = e->arm == kSideName[1] ? 1 : 0;
+          aiming_ = std::move(e);
+        } else {
+          out.push_back(*e);
+        }
         fired_ = true;
       }
       break;
@@ -209,6 +246,12 @@ std::vector<SpottedEvent> Spotter::step(const skeleton::Skeleton& s, const Wrist
 
 std::vector<SpottedEvent> Spotter::close(std::int64_t now_ns, bool final) {
   std::vector<SpottedEvent> out;
+  if (aiming_) {  // the segment ends while the ray is still being gathered (a hold cut short by the end of data)
+    aim(*aiming_, rays_[aiming_side_].empty() ? best_rays_ : rays_[aiming_side_], aiming_side_);
+    aiming_->end_ns = now_ns;
+    out.push_back(std::move(*aiming_));
+    aiming_.reset();
+  }
   const double length = segment_.empty() ? 0.0 : static_cast<double>(segment_.back().t - segment_.front().t) * 1e-9;
   if (!fired_ && length >= o_.min_length) {
     if (auto e = decide(now_ns, false)) out.push_back(*e);
@@ -219,6 +262,32 @@ std::vector<SpottedEvent> Spotter::close(std::int64_t now_ns, bool final) {
   rest_since_ = -1;
   if (final) open_ = false;
   return out;
+}
+
+void Spotter::aim(SpottedEvent& e, const Rays& rays, int side) const {
+  if (rays.empty() || side < 0) return;
+  Vector3d origin = Vector3d::Zero(), dir = Vector3d::Zero();
+  for (const auto& r : rays) {
+    origin += r.origin;
+    dir += r.direction;
+  }
+  origin /= static_cast<double>(rays.size());
+  e.has_ray = dir.norm() > 1e-9;
+  e.ray_origin = origin;
+  e.arm = kSideName[side];
+  e.out = ArmFrame(across_, side == 1).out;
+  e.ray_direction = corrected(dir.normalized(), e.out, c_.pointing_correction());
+  e.has_target = false;
+  double nearest = std::numeric_limits<double>::infinity();
+  for (const auto& s : o_.surfaces) {
+    const auto hit = intersect(origin, e.ray_direction, s);
+    if (hit && (*hit - origin).norm() < nearest) {
+      nearest = (*hit - origin).norm();
+      e.has_target = true;
+      e.target = *hit;
+      e.target_name = s.name;
+    }
+  }
 }
 
 std::optional<SpottedEvent> Spotter::decide(std::int64_t now_ns, bool early) {
@@ -245,29 +314,7 @@ std::optional<SpottedEvent> Spotter::decide(std::int64_t now_ns, bool early) {
     const bool now = early && side >= 0;
     const auto& rays = now ? rays_[side] : best_rays_;
     if (!now) side = best_side_;
-    if (!rays.empty()) {
-      Vector3d origin = Vector3d::Zero(), dir = Vector3d::Zero();
-      for (const auto& [o, d2] : rays) {
-        origin += o;
-        dir += d2;
-      }
-      origin /= static_cast<double>(rays.size());
-      e.has_ray = dir.norm() > 1e-9;
-      e.ray_origin = origin;
-      e.arm = kSideName[side];
-      e.out = side == 1 ? across_ : Vector3d(-across_);
-      e.ray_direction = corrected(dir.normalized(), e.out, c_.pointing_correction());
-      double nearest = std::numeric_limits<double>::infinity();
-      for (const auto& s : o_.surfaces) {
-        const auto hit = intersect(origin, e.ray_direction, s);
-        if (hit && (*hit - origin).norm() < nearest) {
-          nearest = (*hit - origin).norm();
-          e.has_target = true;
-          e.target = *hit;
-          e.target_name = s.name;
-        }
-      }
-    }
+    aim(e, rays, side);
     if (!e.has_ray) return std::nullopt;  // no arm was held out: whatever the models say, this was not pointing
   }
   return e;

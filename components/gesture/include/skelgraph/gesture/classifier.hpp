@@ -81,8 +81,16 @@ struct Decision {
 // shoulder joints where they are not, so the shoulder -> hand ray is off by
 // a repeatable angle. Degrees: the ray is lowered by `elevation` and turned
 // inwards (towards the body's midline) by `azimuth_out`.
+//
+// Before that, the joints themselves: a tracker's shoulder and hand sit a
+// constant offset from the true joints in the body's frame (its skeleton
+// convention), and what that does to the ray depends on where the arm
+// points, so no single angle undoes it. `shoulder` and `hand` are those
+// offsets, metres, as (out, up, forward): out along the shoulders towards
+// the pointing arm's side, up vertical, forward the way the torso faces.
 struct PointingCorrection {
   double elevation = 0.0, azimuth_out = 0.0;
+  Eigen::Vector3d shoulder = Eigen::Vector3d::Zero(), hand = Eigen::Vector3d::Zero();
 };
 
 class Classifier {
@@ -105,7 +113,7 @@ class Classifier {
   void set_pointing_correction(const PointingCorrection& p) { pointing_ = p; }
 
   // "skelgraph-gesture-classifier" version 1: labels, garbage, threshold, feature set, hands, trimmed,
-  // pointing_correction {elevation_deg, azimuth_out_deg} (optional, default 0),
+  // pointing_correction {elevation_deg, azimuth_out_deg, shoulder_offset_m?, hand_offset_m?} (optional, default 0),
   // models (each a skelgraph-hmm with its class index and the action it was trained on).
   nlohmann::json to_json() const;
   static Classifier from_json(const nlohmann::json& j);  // throws ModelError naming the field

@@ -19,7 +19,18 @@ struct SimSession {
   std::vector<skeleton::Skeleton> fused;  // person 1's fused skeletons (world frame), in time order
   std::vector<TruthGesture> truth;        // label point (with hold start and target), wave or stretch
   std::vector<std::pair<std::int64_t, std::int64_t>> rest;  // spans where the person stands at rest
+  // Every frame of a pointing hold: the fused skeleton and the truth at that time, and the arm.
+  struct Hold {
+    skeleton::Skeleton fused, truth;
+    bool right = false;
+  };
+  std::vector<Hold> holds;
 };
+
+// The pointing arm's joint offsets (PointingCorrection::shoulder, hand): the
+// median, per body axis, of where the fused shoulder and hand are against the
+// true ones over the sessions' holds.
+void learn_joint_offsets(const std::vector<SimSession>& sessions, PointingCorrection& c);
 
 // One session of the point scenario with this seed (people = 1, the default two sensors).
 SimSession simulate_session(std::uint64_t seed, const Surface& floor = {});
@@ -51,7 +62,8 @@ std::vector<SessionSpotting> spot_sessions(const Classifier& model, const std::v
 
 // A classifier trained on `sessions` simulated sessions (seeds seed*1000 + i),
 // and the clips it was trained on (count) for reports.
+// The pointing correction is learnt by spotting the training sessions with `spot`.
 Classifier train_on_sim(int sessions, std::uint64_t seed, const ClassifierOptions& options, std::size_t* clips = nullptr,
-                        const std::function<void(int done, int total)>& progress = {});
+                        const std::function<void(int done, int total)>& progress = {}, const SpotterOptions& spot = {});
 
 }  // namespace skelgraph::gesture

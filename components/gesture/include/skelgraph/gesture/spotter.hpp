@@ -17,8 +17,11 @@
 // before) and closes after `settle` s of resting again. Pointing fires early:
 // once an extended arm (shoulder -> hand at least `extended` of the arm's
 // length) has been held still for `hold` s, the segment so far is classified;
-// if the point class wins and is not rejected, the event goes out then, with
-// the ray averaged over the hold. Any other segment is classified when it
+// if the point class wins and is not rejected, the event goes out when the
+// arm moves again or `aim` s after the hold began, whichever is first, with
+// the shoulder -> hand ray averaged over the hold (the trackers' errors
+// wander over about a second, so a longer look halves the target error of a
+// quarter-second one). Any other segment is classified when it
 // closes; an event goes out when its class is neither garbage nor rejected,
 // and for pointing only when an extended arm was held in the segment.
 
@@ -63,6 +66,8 @@ struct SpotterOptions {
   double settle = 0.20;        // s of resting that closes a segment
   double pad = 0.17;           // s of frames before the segment opened that go with it
   double hold = 0.25;          // s an extended arm must be held before pointing is tried
+  double aim = 1.5;            // s of the hold the ray is averaged over, at most (<= hold: the event at once)
+  double warmup = 1.0;         // s after a person's first skeleton before a hold counts (a fresh track is still settling)
   double extended = 0.80;      // shoulder -> hand share of the arm's length that counts as extended
   double min_length = 0.4;     // s: shorter segments are ignored
   double max_length = 10.0;    // s: longer ones are cut (classified and reopened)
@@ -83,6 +88,15 @@ struct SpottedEvent {
   std::string target_name;
   std::string arm;                        // "left" / "right" for pointing
   Eigen::Vector3d out = Eigen::Vector3d::Zero();  // horizontal, away from the body on the pointing arm's side
+};
+
+// One arm's body axes (PointingCorrection's joint offsets are in them), from
+// the shoulders' left -> right direction (horizontal).
+struct ArmFrame {
+  ArmFrame(const Eigen::Vector3d& across, bool right);
+  Eigen::Vector3d out, up, forward;
+  Eigen::Vector3d to_world(const Eigen::Vector3d& body) const { return body.x() * out + body.y() * up + body.z() * forward; }
+  Eigen::Vector3d to_body(const Eigen::Vector3d& w) const { return {w.dot(out), w.dot(up), w.dot(forward)}; }
 };
 
 // The ray turned by a correction (see PointingCorrection); `out` as in SpottedEvent.
@@ -108,6 +122,12 @@ class Spotter {
   };
   std::vector<SpottedEvent> close(std::int64_t now_ns, bool final);
   std::optional<SpottedEvent> decide(std::int64_t now_ns, bool early);
+  struct RaySample {
+    std::int64_t t;
+    Eigen::Vector3d origin, direction;
+  };
+  using Rays = std::vector<RaySample>;
+  void aim(SpottedEvent& e, const Rays& rays, int side) const;  // the ray and its target
 
   const Classifier& c_;
   SpotterOptions o_;
@@ -120,11 +140,14 @@ class Spotter {
   Eigen::Vector3d last_hand_[2];  // smoothed
   std::deque<std::pair<std::int64_t, Eigen::Vector3d>> trail_[2];
   bool have_last_ = false;
+  std::int64_t first_ns_ = -1;  // the person's first skeleton
   MotionState state_ = MotionState::Resting;
   // Ray samples of the current hold per arm (origin, direction).
-  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> rays_[2];
-  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> best_rays_;  // the segment's longest hold
+  Rays rays_[2];
+  Rays best_rays_;  // the segment's longest hold
   int best_side_ = -1;
+  std::optional<SpottedEvent> aiming_;  // pointing decided, its ray still gathered over the hold
+  int aiming_side_ = -1;
   bool have_hand_[2] = {false, false};
   std::uint32_t person_ = 0;
   Eigen::Vector3d across_ = Eigen::Vector3d::UnitX();  // left -> right shoulder, horizontal
