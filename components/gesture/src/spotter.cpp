@@ -129,10 +129,7 @@ std::vector<SpottedEvent> Spotter::step(const skeleton::Skeleton& s, const Wrist
     if (moving) {
       while (rays.size() > 1 && rays.back().t > cut) rays.pop_back();
     }
-    aim(*aiming_, rays, side);
-    if (!rays.empty()) aiming_->end_ns = std::max(aiming_->end_ns, rays.back().t);
-    out.push_back(std::move(*aiming_));
-    aiming_.reset();
+    out.push_back(release_aiming(rays, rays.empty() ? aiming_->end_ns : std::max(aiming_->end_ns, rays.back().t)));
   };
   const double dt = have_last_ && t > last_ns_ ? static_cast<double>(t - last_ns_) * 1e-9 : 1.0 / 30;
   const Eigen::VectorXd x = features_.step(s, nullptr, nullptr, wrists);
@@ -246,12 +243,8 @@ std::vector<SpottedEvent> Spotter::step(const skeleton::Skeleton& s, const Wrist
 
 std::vector<SpottedEvent> Spotter::close(std::int64_t now_ns, bool final) {
   std::vector<SpottedEvent> out;
-  if (aiming_) {  // the segment ends while the ray is still being gathered (a hold cut short by the end of data)
-    aim(*aiming_, rays_[aiming_side_].empty() ? best_rays_ : rays_[aiming_side_], aiming_side_);
-    aiming_->end_ns = now_ns;
-    out.push_back(std::move(*aiming_));
-    aiming_.reset();
-  }
+  if (aiming_)  // the segment ends while the ray is still being gathered (a hold cut short by the end of data)
+    out.push_back(release_aiming(rays_[aiming_side_].empty() ? best_rays_ : rays_[aiming_side_], now_ns));
   const double length = segment_.empty() ? 0.0 : static_cast<double>(segment_.back().t - segment_.front().t) * 1e-9;
   if (!fired_ && length >= o_.min_length) {
     if (auto e = decide(now_ns, false)) out.push_back(*e);
@@ -262,6 +255,14 @@ std::vector<SpottedEvent> Spotter::close(std::int64_t now_ns, bool final) {
   rest_since_ = -1;
   if (final) open_ = false;
   return out;
+}
+
+SpottedEvent Spotter::release_aiming(const Rays& rays, std::int64_t end_ns) {
+  SpottedEvent e = std::move(*aiming_);
+  aiming_.reset();
+  aim(e, rays, aiming_side_);
+  e.end_ns = end_ns;
+  return e;
 }
 
 void Spotter::aim(SpottedEvent& e, const Rays& rays, int side) const {

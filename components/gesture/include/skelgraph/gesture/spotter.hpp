@@ -128,6 +128,7 @@ class Spotter {
   };
   using Rays = std::vector<RaySample>;
   void aim(SpottedEvent& e, const Rays& rays, int side) const;  // the ray and its target
+  SpottedEvent release_aiming(const Rays& rays, std::int64_t end_ns);  // the gathered pointing event, aimed
 
   const Classifier& c_;
   SpotterOptions o_;
