@@ -1,4 +1,5 @@
 // The HMM core: forward and Viterbi against brute force over every path,
+// emissions far from the origin against the Gaussians evaluated directly,
 // no underflow on long sequences, streaming equals batch, Baum-Welch raises
 // the likelihood and finds the generating model's states, save/load and
 // malformed models.
@@ -156,6 +157,63 @@ TEST(Hmm, BaumWelchFindsTheGeneratingStates) {
   const Hmm lr = Hmm::train(data, o);
   EXPECT_EQ(lr.transitions()(2, 0), 0.0);
   EXPECT_EQ(lr.emissions()[0].covs[0](0, 1), 0.0);
+}
+
+// The forward pass in log space, each emission straight from its Gaussians
+// (Cholesky factors), none of the batched quadratic-feature arithmetic.
+double log_space_forward(const Hmm& h, const Sequence& x) {
+  const auto n = h.states();
+  const MatrixXd log_a = h.transitions().array().log().matrix();
+  VectorXd alpha = h.start().array().log().matrix(), next(n);
+  for (Eigen::Index t = 0; t < x.rows(); ++t) {
+    for (int j = 0; j < n; ++j) {
+      const double e = h.emissions()[static_cast<std::size_t>(j)].log_pdf(x.row(t).transpose());
+      next(j) = e + (t == 0 ? alpha(j) : log_sum_exp(alpha + log_a.col(j)));
+    }
+    alpha = next;
+  }
+  return log_sum_exp(alpha);
+}
+
+TEST(Hmm, FramesFarFromTheOriginKeepTheirPrecision) {
+  // Narrow Gaussians 1000 units from the origin: expanding (x - mu)' P (x - mu)
+  // about the origin would cancel away most of the digits.
+  for (const auto cov : {Covariance::Full, Covariance::Diagonal}) {
+    Hmm h = three_states();
+    VectorXd start = h.start();
+    std::vector<GaussianMixture> em = h.emissions();
+    for (auto& g : em) {
+      for (std::size_t m = 0; m < g.means.size(); ++m) {
+        g.means[m].array() += 1000.0;
+        g.covs[m] *= 0.01;
+        if (cov == Covariance::Diagonal) g.covs[m] = MatrixXd(g.covs[m].diagonal().asDiagonal());
+      }
+    }
+    Hmm far(3, 2, cov);
+    far.set(start, h.transitions(), em);
+    std::mt19937_64 rng(7);
+    for (int i = 0; i < 5; ++i) {
+      const Sequence x = sample(far, 50, rng);
+      const double want = log_space_forward(far, x);
+      EXPECT_NEAR(far.log_likelihood(x), want, 1e-9 * std::abs(want));
+    }
+  }
+  // Training on data moved by 1000 finds the same model, moved.
+  const Hmm truth = three_states();
+  std::mt19937_64 rng(8);
+  std::vector<Sequence> near, moved;
+  for (int i = 0; i < 30; ++i) {
+    near.push_back(sample(truth, 40, rng));
+    moved.push_back(near.back().array() + 1000.0);
+  }
+  TrainOptions o;
+  o.states = 3;
+  o.mixtures = 2;
+  o.max_iterations = 20;
+  const Hmm a = Hmm::train(near, o), b = Hmm::train(moved, o);
+  for (std::size_t i = 0; i < 5; ++i) {
+    EXPECT_NEAR(b.log_likelihood(moved[i]), a.log_likelihood(near[i]), 1e-6 * std::abs(a.log_likelihood(near[i])));
+  }
 }
 
 TEST(Hmm, SaveLoadAndMalformedModels) {

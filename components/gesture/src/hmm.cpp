@@ -15,6 +15,52 @@ using Eigen::VectorXd;
 namespace {
 constexpr double kNegInf = -std::numeric_limits<double>::infinity();
 double safe_log(double p) { return p > 0 ? std::log(p) : kNegInf; }
+
+// Frames as quadratic features q(x) = [1, x, x_a x_b (a <= b)] (diagonal
+// covariances: [1, x, x_a^2]), x taken from a centre near the data (a
+// model's mean, the training frames' mean) so that no large terms cancel:
+// a Gaussian's log density is linear in q, and so are the sums Baum-Welch
+// needs, so the emissions of every frame and component are the one product
+// Q C, and an iteration's statistics the one product Q^T R.
+Eigen::Index quadratic_size(Eigen::Index d, Covariance c) { return 1 + d + (c == Covariance::Full ? d * (d + 1) / 2 : d); }
+
+MatrixXd quadratic_features(const MatrixXd& xc, Covariance c) {
+  const auto d = xc.cols();
+  MatrixXd q(xc.rows(), quadratic_size(d, c));
+  q.col(0).setOnes();
+  q.middleCols(1, d) = xc;
+  Eigen::Index col = 1 + d;
+  for (Eigen::Index a = 0; a < d; ++a) {
+    for (Eigen::Index b = a; b < (c == Covariance::Full ? d : a + 1); ++b) q.col(col++) = xc.col(a).cwiseProduct(xc.col(b));
+  }
+  return q;
+}
+
+// The coefficients with q(x) . c = log w + log N(x; mu, S) for x and mu centred alike.
+void quadratic_coefficients(const VectorXd& mu_c, const MatrixXd& precision, double log_norm, Covariance cov,
+                            Eigen::Ref<VectorXd> c) {
+  const auto d = mu_c.size();
+  const VectorXd pm = precision * mu_c;
+  c(0) = log_norm - 0.5 * mu_c.dot(pm);
+  c.segment(1, d) = pm;
+  Eigen::Index col = 1 + d;
+  for (Eigen::Index a = 0; a < d; ++a) {
+    for (Eigen::Index b = a; b < (cov == Covariance::Full ? d : a + 1); ++b) c(col++) = a == b ? -0.5 * precision(a, a) : -precision(a, b);
+  }
+}
+
+// Mean (centred) and covariance from a component's column of Q^T R.
+void moments(const Eigen::Ref<const VectorXd>& s, Eigen::Index d, Covariance cov, VectorXd& mu_c, MatrixXd& out) {
+  const double n = s(0);
+  mu_c = s.segment(1, d) / n;
+  out = MatrixXd::Zero(d, d);
+  Eigen::Index col = 1 + d;
+  for (Eigen::Index a = 0; a < d; ++a) {
+    for (Eigen::Index b = a; b < (cov == Covariance::Full ? d : a + 1); ++b) {
+      out(a, b) = out(b, a) = s(col++) / n - mu_c(a) * mu_c(b);
+    }
+  }
+}
 }  // namespace
 
 double log_sum_exp(const VectorXd& v) {
@@ -112,20 +158,135 @@ void Hmm::set(const VectorXd& start, const MatrixXd& transitions, std::vector<Ga
     off += e.weights.size();
   }
   offsets_.push_back(off);
+  centre_ = VectorXd::Zero(dim_);
+  for (const auto& e : emissions_) {
+    for (const auto& m : e.means) centre_ += m / static_cast<double>(off);
+  }
+  quadratic_coefficients(centre_, quad_);
 }
 
 VectorXd Hmm::start() const { return start_; }
 MatrixXd Hmm::transitions() const { return trans_; }
 
-MatrixXd Hmm::log_emissions(const Sequence& x) const {
+void Hmm::emissions_of(const MatrixXd& x, Eigen::Ref<Pass::Rows> comp, Eigen::Ref<Pass::Rows> logb) const {
   if (x.cols() != dim_) throw ModelError("sequence has " + std::to_string(x.cols()) + " features per frame, the model " + std::to_string(dim_));
-  MatrixXd comp(x.rows(), offsets_.back()), b(x.rows(), states());
+  comp.noalias() = quadratic_features(x.rowwise() - centre_.transpose(), covariance_) * quad_;
+  states_of(comp, logb);
+}
+
+void Hmm::quadratic_coefficients(const VectorXd& centre, MatrixXd& c) const {
+  c.resize(quadratic_size(dim_, covariance_), offsets_.back());
+  for (int j = 0; j < states(); ++j) {
+    const auto& g = emissions_[static_cast<std::size_t>(j)];
+    for (std::size_t m = 0; m < g.means.size(); ++m) {
+      gesture::quadratic_coefficients(g.means[m] - centre, g.precision(m), g.log_norm(m), covariance_,
+                                      c.col(offsets_[static_cast<std::size_t>(j)] + static_cast<Eigen::Index>(m)));
+    }
+  }
+}
+
+void Hmm::states_of(const Eigen::Ref<const Pass::Rows>& comp, Eigen::Ref<Pass::Rows> logb) const {
   for (int j = 0; j < states(); ++j) {
     const auto off = offsets_[static_cast<std::size_t>(j)], m = offsets_[static_cast<std::size_t>(j) + 1] - off;
-    emissions_[static_cast<std::size_t>(j)].log_pdf_components(x, comp.middleCols(off, m));
-    for (Eigen::Index t = 0; t < x.rows(); ++t) b(t, j) = log_sum_exp(comp.row(t).segment(off, m).transpose());
+    if (m == 1) {
+      logb.col(j) = comp.col(off);
+    } else {
+      const VectorXd mx = comp.middleCols(off, m).rowwise().maxCoeff();
+      logb.col(j) = mx.array() + ((comp.middleCols(off, m).colwise() - mx).array().exp().rowwise().sum()).log();
+    }
   }
-  return b;
+}
+
+namespace {
+
+// Rows of a row-major matrix (or a block of one) as a pointer and a stride.
+struct RowsView {
+  double* data;
+  Eigen::Index stride;
+  double* row(Eigen::Index t) const { return data + t * stride; }
+};
+
+// The scaled forward (and backward) recursions. NN > 0 fixes the number of
+// states at compile time, so that the N x N loops unroll into straight
+// vector code (N is 2-10 in practice); NN = 0 takes N at run time.
+template <int NN>
+double forward_backward_kernel(int n, const double* start, const double* A_cols, const double* A_rows, RowsView logb,
+                               RowsView B, RowsView alpha, RowsView beta, double* scale, Eigen::Index T, bool with_backward) {
+  const int N = NN > 0 ? NN : n;
+  double ll = 0;
+  constexpr int kMaxStack = 16;
+  double stack[kMaxStack];
+  std::vector<double> heap(N > kMaxStack ? static_cast<std::size_t>(N) : 0);
+  double* __restrict v = N > kMaxStack ? heap.data() : stack;
+  for (Eigen::Index t = 0; t < T; ++t) {
+    // Emissions scaled by the frame's largest.
+    const double* __restrict lb = logb.row(t);
+    double mx = lb[0];
+    for (int j = 1; j < N; ++j) mx = std::max(mx, lb[j]);
+    if (!std::isfinite(mx)) return kNegInf;  // no state can emit this frame
+    double* __restrict b = B.row(t);
+    for (int j = 0; j < N; ++j) b[j] = std::exp(lb[j] - mx);
+    double* __restrict a = alpha.row(t);
+    if (t == 0) {
+      for (int j = 0; j < N; ++j) a[j] = start[j] * b[j];
+    } else {
+      const double* __restrict prev = alpha.row(t - 1);
+      for (int j = 0; j < N; ++j) v[j] = 0;
+      for (int i = 0; i < N; ++i) {
+        const double p = prev[i];
+        const double* __restrict row = A_rows + static_cast<std::ptrdiff_t>(i) * N;
+        for (int j = 0; j < N; ++j) v[j] += p * row[j];
+      }
+      for (int j = 0; j < N; ++j) a[j] = v[j] * b[j];
+    }
+    double c = 0;
+    for (int j = 0; j < N; ++j) c += a[j];
+    if (!(c > 0)) return kNegInf;
+    const double inv = 1.0 / c;
+    for (int j = 0; j < N; ++j) a[j] *= inv;
+    scale[t] = c;
+    ll += std::log(c) + mx;
+  }
+  if (with_backward) {
+    for (int j = 0; j < N; ++j) beta.row(T - 1)[j] = 1.0;
+    for (Eigen::Index t = T - 2; t >= 0; --t) {
+      const double* __restrict b = B.row(t + 1);
+      const double* __restrict nb = beta.row(t + 1);
+      double* __restrict out = beta.row(t);
+      const double inv = 1.0 / scale[t + 1];
+      for (int i = 0; i < N; ++i) out[i] = 0;
+      for (int j = 0; j < N; ++j) {
+        const double w = b[j] * nb[j] * inv;
+        const double* __restrict col = A_cols + static_cast<std::ptrdiff_t>(j) * N;
+        for (int i = 0; i < N; ++i) out[i] += col[i] * w;
+      }
+    }
+  }
+  return ll;
+}
+
+}  // namespace
+
+double Hmm::forward_backward(const Eigen::Ref<const Pass::Rows>& logb, Eigen::Ref<Pass::Rows> B, Eigen::Ref<Pass::Rows> alpha,
+                             Eigen::Ref<Pass::Rows> beta, Eigen::Ref<VectorXd> scale, bool with_backward) const {
+  const int N = states();
+  const Pass::Rows A_rows = trans_;  // row i contiguous: a_i*; trans_ (column-major) has column j contiguous
+  const RowsView lb{const_cast<double*>(logb.data()), logb.outerStride()};
+  const RowsView b{B.data(), B.outerStride()}, a{alpha.data(), alpha.outerStride()};
+  const RowsView be{with_backward ? beta.data() : nullptr, with_backward ? beta.outerStride() : 0};
+  const auto run = [&](auto kernel) {
+    return kernel(N, start_.data(), trans_.data(), A_rows.data(), lb, b, a, be, scale.data(), logb.rows(), with_backward);
+  };
+  switch (N) {
+    case 2: return run(forward_backward_kernel<2>);
+    case 3: return run(forward_backward_kernel<3>);
+    case 4: return run(forward_backward_kernel<4>);
+    case 5: return run(forward_backward_kernel<5>);
+    case 6: return run(forward_backward_kernel<6>);
+    case 7: return run(forward_backward_kernel<7>);
+    case 8: return run(forward_backward_kernel<8>);
+    default: return run(forward_backward_kernel<0>);
+  }
 }
 
 Hmm::Pass Hmm::pass(const Sequence& x, bool with_backward) const {
@@ -135,48 +296,12 @@ Hmm::Pass Hmm::pass(const Sequence& x, bool with_backward) const {
   const int N = states();
   p.comp.resize(T, offsets_.back());
   p.logb.resize(T, N);
-  for (int j = 0; j < N; ++j) {
-    const auto off = offsets_[static_cast<std::size_t>(j)], m = offsets_[static_cast<std::size_t>(j) + 1] - off;
-    emissions_[static_cast<std::size_t>(j)].log_pdf_components(x, p.comp.middleCols(off, m));
-    if (m == 1) {
-      p.logb.col(j) = p.comp.col(off);
-    } else {
-      const VectorXd mx = p.comp.middleCols(off, m).rowwise().maxCoeff();
-      p.logb.col(j) = mx.array() + ((p.comp.middleCols(off, m).colwise() - mx).array().exp().rowwise().sum()).log();
-    }
-  }
-  const VectorXd rowmax = p.logb.rowwise().maxCoeff();
-  p.B = (p.logb.colwise() - rowmax).array().exp().matrix();
+  emissions_of(x, p.comp, p.logb);
+  p.B.resize(T, N);
   p.alpha.resize(T, N);
   p.scale.resize(T);
-  p.log_likelihood = 0;
-  Eigen::RowVectorXd prior(N);
-  for (Eigen::Index t = 0; t < T; ++t) {
-    if (!std::isfinite(rowmax(t))) {
-      p.log_likelihood = kNegInf;  // no state can emit this frame
-      return p;
-    }
-    if (t == 0) prior = start_.transpose();
-    else prior.noalias() = p.alpha.row(t - 1) * trans_;
-    p.alpha.row(t) = prior.cwiseProduct(p.B.row(t));
-    p.scale(t) = p.alpha.row(t).sum();
-    if (!(p.scale(t) > 0)) {
-      p.log_likelihood = kNegInf;
-      return p;
-    }
-    p.alpha.row(t) /= p.scale(t);
-    p.log_likelihood += std::log(p.scale(t)) + rowmax(t);
-  }
-  if (with_backward) {
-    p.beta.resize(T, N);
-    p.beta.row(T - 1).setOnes();
-    VectorXd v(N), w(N);
-    for (Eigen::Index t = T - 2; t >= 0; --t) {
-      v = p.B.row(t + 1).cwiseProduct(p.beta.row(t + 1)).transpose();
-      w.noalias() = trans_ * v;
-      p.beta.row(t) = w.transpose() / p.scale(t + 1);
-    }
-  }
+  p.beta.resize(with_backward ? T : 0, N);
+  p.log_likelihood = forward_backward(p.logb, p.B, p.alpha, p.beta, p.scale, with_backward);
   return p;
 }
 
@@ -193,7 +318,9 @@ std::vector<int> Hmm::viterbi(const Sequence& x, double* log_prob) const {
     if (log_prob) *log_prob = 0;
     return path;
   }
-  const MatrixXd logb = log_emissions(x);
+  if (x.cols() != dim_) throw ModelError("sequence has " + std::to_string(x.cols()) + " features per frame, the model " + std::to_string(dim_));
+  Pass::Rows comp(T, offsets_.back()), logb(T, N);
+  emissions_of(x, comp, logb);
   MatrixXd delta(T, N);
   Eigen::MatrixXi psi(T, N);
   delta.row(0) = (log_start_ + logb.row(0).transpose()).transpose();
@@ -387,42 +514,41 @@ Hmm Hmm::train(const std::vector<Sequence>& data, const TrainOptions& o, TrainRe
   Hmm h(N, static_cast<int>(D), o.covariance);
   h.set(start, trans, em);
 
+  // Every frame of every sequence stacked once, centred, as quadratic features.
+  const auto F = static_cast<Eigen::Index>(frames);
+  const int K = N * M;  // components of all states, in Pass::comp's column order
+  std::vector<Eigen::Index> first(data.size() + 1, 0);
+  MatrixXd Q;
+  {
+    MatrixXd xc(F, D);
+    for (std::size_t s = 0; s < data.size(); ++s) {
+      first[s + 1] = first[s] + data[s].rows();
+      xc.middleRows(first[s], data[s].rows()) = data[s].rowwise() - mean.transpose();
+    }
+    Q = quadratic_features(xc, o.covariance);
+  }
+  MatrixXd C(Q.cols(), K), R(F, K);
+  Pass::Rows comp(F, K), logb(F, N), B(F, N), alpha(F, N), beta(F, N), W(F, N);
+  VectorXd scale(F);
+
   TrainReport rep;
   double previous = kNegInf;
   for (int iter = 0; iter <= o.max_iterations; ++iter) {
     // E-step over every sequence with the current parameters.
-    VectorXd start_acc = VectorXd::Zero(N);
-    MatrixXd trans_acc = MatrixXd::Zero(N, N);
-    std::vector<VectorXd> n_acc(static_cast<std::size_t>(N), VectorXd::Zero(M));
-    std::vector<std::vector<VectorXd>> x_acc(static_cast<std::size_t>(N), std::vector<VectorXd>(static_cast<std::size_t>(M), VectorXd::Zero(D)));
-    std::vector<std::vector<MatrixXd>> xx_acc(static_cast<std::size_t>(N), std::vector<MatrixXd>(static_cast<std::size_t>(M), MatrixXd::Zero(D, D)));
+    h.quadratic_coefficients(mean, C);
+    comp.noalias() = Q * C;
+    h.states_of(comp, logb);
     double total = 0;
-    for (const auto& x : data) {
-      const auto T = x.rows();
-      const Pass p = h.pass(x, true);
-      if (!std::isfinite(p.log_likelihood)) {
+    VectorXd start_acc = VectorXd::Zero(N);
+    for (std::size_t s = 0; s < data.size(); ++s) {
+      const auto b = first[s], T = first[s + 1] - b;
+      const double ll = h.forward_backward(logb.middleRows(b, T), B.middleRows(b, T), alpha.middleRows(b, T),
+                                           beta.middleRows(b, T), scale.segment(b, T), true);
+      if (!std::isfinite(ll)) {
         throw ModelError("training: a sequence has zero likelihood under the model (a left-right model shorter than it needs?)");
       }
-      total += p.log_likelihood;
-      const MatrixXd gamma = p.alpha.cwiseProduct(p.beta);  // rows sum to 1
-      start_acc += gamma.row(0).transpose();
-      if (T > 1) {
-        // xi summed over time: A .* (alpha[0..T-2]^T * (B .* beta)[1..T-1] / c)
-        const MatrixXd W = (p.B.bottomRows(T - 1).cwiseProduct(p.beta.bottomRows(T - 1))).array().colwise() /
-                           p.scale.tail(T - 1).array();
-        trans_acc += h.trans_.cwiseProduct(p.alpha.topRows(T - 1).transpose() * W);
-      }
-      for (int j = 0; j < N; ++j) {
-        const auto off = h.offsets_[static_cast<std::size_t>(j)];
-        for (int m = 0; m < M; ++m) {
-          const VectorXd r = gamma.col(j).cwiseProduct((p.comp.col(off + m) - p.logb.col(j)).array().exp().matrix());
-          n_acc[static_cast<std::size_t>(j)](m) += r.sum();
-          x_acc[static_cast<std::size_t>(j)][static_cast<std::size_t>(m)] += x.transpose() * r;
-          // sum_t r_t x_t x_t^T as a symmetric rank-k update (half the work of a full product).
-          const MatrixXd xs = (x.array().colwise() * r.array().sqrt()).matrix();
-          xx_acc[static_cast<std::size_t>(j)][static_cast<std::size_t>(m)].selfadjointView<Eigen::Lower>().rankUpdate(xs.transpose());
-        }
-      }
+      total += ll;
+      start_acc += alpha.row(b).cwiseProduct(beta.row(b)).transpose();
     }
     rep.log_likelihood.push_back(total);
     const double gain = (total - previous) / static_cast<double>(frames);
@@ -433,6 +559,23 @@ Hmm Hmm::train(const std::vector<Sequence>& data, const TrainOptions& o, TrainRe
     if (iter == o.max_iterations) break;
     previous = total;
     rep.iterations = iter + 1;
+    // State posteriors (rows of alpha .* beta sum to 1) and, for xi summed
+    // over time, A .* (alpha[t]^T * (B .* beta)[t+1] / c[t+1]) with no pair
+    // across two sequences (W is zero on every sequence's first frame).
+    const MatrixXd gamma = alpha.cwiseProduct(beta);
+    W = B.cwiseProduct(beta);
+    W.array().colwise() /= scale.array();
+    for (std::size_t s = 0; s < data.size(); ++s) W.row(first[s]).setZero();
+    const MatrixXd trans_acc = h.trans_.cwiseProduct(alpha.topRows(F - 1).transpose() * W.bottomRows(F - 1));
+    // Each component's responsibility for each frame, then its weighted sums.
+    for (int j = 0; j < N; ++j) {
+      const auto off = h.offsets_[static_cast<std::size_t>(j)];
+      for (int m = 0; m < M; ++m) {
+        if (M == 1) R.col(off) = gamma.col(j);
+        else R.col(off + m) = gamma.col(j).cwiseProduct((comp.col(off + m) - logb.col(j)).array().exp().matrix());
+      }
+    }
+    const MatrixXd S = Q.transpose() * R;  // per component: sum r, sum r x, sum r x_a x_b
     // M-step.
     VectorXd new_start = start_acc / start_acc.sum();
     MatrixXd new_trans = h.transitions();
@@ -443,10 +586,11 @@ Hmm Hmm::train(const std::vector<Sequence>& data, const TrainOptions& o, TrainRe
     std::vector<GaussianMixture> new_em(static_cast<std::size_t>(N));
     for (int j = 0; j < N; ++j) {
       auto& g = new_em[static_cast<std::size_t>(j)];
-      const auto& nj = n_acc[static_cast<std::size_t>(j)];
+      const auto off = h.offsets_[static_cast<std::size_t>(j)];
       g.weights = VectorXd::Zero(M);
       for (int m = 0; m < M; ++m) {
-        const double n = nj(m);
+        const auto k = off + m;
+        const double n = S(0, k);
         if (n < 1e-6) {
           // A component nothing belongs to: start it again on a random frame.
           const auto& x = data[std::uniform_int_distribution<std::size_t>(0, data.size() - 1)(rng)];
@@ -455,9 +599,10 @@ Hmm Hmm::train(const std::vector<Sequence>& data, const TrainOptions& o, TrainRe
           g.weights(m) = 1e-3;
           continue;
         }
-        const VectorXd mu = x_acc[static_cast<std::size_t>(j)][static_cast<std::size_t>(m)] / n;
-        const MatrixXd xx = xx_acc[static_cast<std::size_t>(j)][static_cast<std::size_t>(m)].selfadjointView<Eigen::Lower>();
-        const MatrixXd cov = xx / n - mu * mu.transpose();
+        VectorXd mu;
+        MatrixXd cov;
+        moments(S.col(k), D, o.covariance, mu, cov);
+        mu += mean;
         g.means.push_back(mu);
         g.covs.push_back(shape(cov, o.covariance, reg));
         g.weights(m) = n;

@@ -1,6 +1,6 @@
 #pragma once
 // Continuous hidden Markov models with Gaussian-mixture emissions (full or
-// diagonal covariances), in log space throughout: forward log-likelihood,
+// diagonal covariances), with no underflow on any length: forward log-likelihood,
 // Viterbi path, state posteriors, a streaming forward step for live use, and
 // Baum-Welch training over many sequences of different lengths. Eigen only;
 // models save to and load from versioned JSON.
@@ -36,6 +36,9 @@ struct GaussianMixture {
   void log_pdf_components(const Eigen::VectorXd& x, Eigen::VectorXd& out) const;  // log w_m + log N_m
   // log w_m + log N_m(x_t) for every frame (row) of X at once: out is T x M.
   void log_pdf_components(const Eigen::MatrixXd& X, Eigen::Ref<Eigen::MatrixXd> out) const;
+  // After prepare(): component m's inverse covariance and log w_m + its log normaliser.
+  Eigen::MatrixXd precision(std::size_t m) const { return inv_l_[m].transpose() * inv_l_[m]; }
+  double log_norm(std::size_t m) const { return log_norm_(static_cast<Eigen::Index>(m)); }
 
  private:
   std::vector<Eigen::MatrixXd> inv_l_;  // L^-1 with S = L L^T
@@ -103,9 +106,9 @@ class Hmm {
   // scaled by their largest, alpha normalised every frame): no exp or log per
   // cell, matrix products instead, and no underflow on any length.
   struct Pass {
-    Eigen::MatrixXd comp;    // T x (sum of M): log w_m + log N_m per state's components
-    Eigen::MatrixXd logb;    // T x N
     using Rows = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;  // a frame is contiguous
+    Rows comp;               // T x (sum of M): log w_m + log N_m per state's components
+    Rows logb;               // T x N
     Rows B;                  // T x N, exp(logb - rowmax)
     Rows alpha, beta;        // scaled: rows of alpha sum to 1; alpha .* beta = posteriors
     Eigen::VectorXd scale;   // c_t
@@ -114,7 +117,17 @@ class Hmm {
   Pass pass(const Sequence& x, bool with_backward) const;
 
  private:
-  Eigen::MatrixXd log_emissions(const Sequence& x) const;  // T x N
+  // log w_m + log N_m per state's components (comp, T x sum of M) and log b_j (logb, T x N) for every frame of x.
+  void emissions_of(const Eigen::MatrixXd& x, Eigen::Ref<Pass::Rows> comp, Eigen::Ref<Pass::Rows> logb) const;
+  void states_of(const Eigen::Ref<const Pass::Rows>& comp, Eigen::Ref<Pass::Rows> logb) const;  // logb from comp
+  // Every component's coefficients on the quadratic features of frames taken from `centre` (hmm.cpp).
+  void quadratic_coefficients(const Eigen::VectorXd& centre, Eigen::MatrixXd& c) const;
+  Eigen::VectorXd centre_;  // the components' mean, where emissions_of takes frames from
+  Eigen::MatrixXd quad_;    // quadratic_coefficients(centre_)
+  // The scaled forward (and backward) recursions over frames with log emissions logb;
+  // fills B, alpha, scale (and beta); returns the log-likelihood (-inf: impossible).
+  double forward_backward(const Eigen::Ref<const Pass::Rows>& logb, Eigen::Ref<Pass::Rows> B, Eigen::Ref<Pass::Rows> alpha,
+                          Eigen::Ref<Pass::Rows> beta, Eigen::Ref<Eigen::VectorXd> scale, bool with_backward) const;
   std::vector<Eigen::Index> offsets_;  // first column of each state's components in Pass::comp
 
   int dim_ = 0;
