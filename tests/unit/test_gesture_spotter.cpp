@@ -4,7 +4,9 @@
 // the true one, waves and stretches mostly left alone).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <set>
 
@@ -130,4 +132,118 @@ TEST(Spotting, FindsPointingInHeldOutSimulatedSessions) {
   EXPECT_GE(quick.true_positive, 4);
   EXPECT_LT(quick.median_latency_hold_s, 0.8);
   EXPECT_LT(quick.median_latency_hold_s, r.median_latency_hold_s - 0.5);
+}
+
+namespace {
+
+// A classifier with "point" as its only class that never rejects: every
+// segment the spotter tries is pointing, so the tests below see exactly
+// when the spotter tries (the classifier is not what they are about).
+Classifier always_point() {
+  std::vector<Clip> clips;
+  for (int i = 0; i < 4; ++i) {
+    Clip c;
+    c.label = 0;
+    c.x = Sequence::Random(30, 8);
+    clips.push_back(c);
+  }
+  ClassMap map;
+  map.classes = {"point"};
+  ClassifierOptions o;
+  o.hmm.states = 1;
+  o.hmm.covariance = Covariance::Diagonal;
+  o.trimmed = false;
+  o.calibration_folds = 0;
+  Classifier c = Classifier::train(clips, map, o);
+  c.set_threshold(-1e300);
+  return c;
+}
+
+// A person at the origin facing +z, arms straight, the left one hanging; the
+// right one raised forward by raise(t) degrees from hanging, at 30 Hz from
+// 0 to `until` s, leaving out the frames in [gap_from, gap_to).
+std::vector<skelgraph::skeleton::Skeleton> arm_stream(const std::function<double(double)>& raise, double until,
+                                                      double gap_from = -1, double gap_to = -1) {
+  std::vector<skelgraph::skeleton::Skeleton> out;
+  for (int i = 0; i / 30.0 <= until; ++i) {
+    const double t = i / 30.0;
+    if (t >= gap_from && t < gap_to) continue;
+    skelgraph::skeleton::Skeleton s;
+    s.person_id = 1;
+    s.frame_id = "world";
+    s.stamp_ns = static_cast<std::int64_t>(std::llround(t * 1e9));
+    const auto set = [&](JointId j, const Vector3d& p) {
+      s[j].position = p;
+      s[j].confidence = skelgraph::skeleton::kTracked;
+    };
+    set(JointId::Head, {0, 1.7, 0});
+    set(JointId::Neck, {0, 1.5, 0});
+    set(JointId::Torso, {0, 1.2, 0});
+    set(JointId::LeftShoulder, {-0.2, 1.45, 0});
+    set(JointId::LeftElbow, {-0.2, 1.15, 0});
+    set(JointId::LeftHand, {-0.2, 0.85, 0});
+    const double a = raise(t) * M_PI / 180;
+    const Vector3d sh(0.2, 1.45, 0), dir(0, -std::cos(a), std::sin(a));
+    set(JointId::RightShoulder, sh);
+    set(JointId::RightElbow, sh + 0.3 * dir);
+    set(JointId::RightHand, sh + 0.6 * dir);
+    out.push_back(s);
+  }
+  return out;
+}
+
+std::vector<SpottedEvent> spot(const Classifier& c, const std::vector<skelgraph::skeleton::Skeleton>& stream,
+                               const SpotterOptions& o = {}) {
+  Spotter sp(c, o);
+  std::vector<SpottedEvent> events;
+  for (const auto& s : stream) {
+    for (auto& e : sp.step(s)) events.push_back(e);
+  }
+  return events;
+}
+
+// Rest, raise over 0.5 s from `from`, hold `angle` degrees for 3 s, lower, rest.
+std::function<double(double)> gesture(double from, double angle) {
+  return [=](double t) {
+    const double u = std::clamp((t - from) / 0.5, 0.0, 1.0) - std::clamp((t - from - 3.5) / 0.5, 0.0, 1.0);
+    return angle * u;
+  };
+}
+
+}  // namespace
+
+TEST(Spotting, AHangingArmIsNoPointing) {
+  const auto c = always_point();
+  // Pointing at the floor ahead (70 degrees up from hanging): one event, its ray that way.
+  const auto held = spot(c, arm_stream(gesture(2.0, 70), 8));
+  ASSERT_EQ(held.size(), 1u);
+  ASSERT_TRUE(held[0].has_ray);
+  EXPECT_NEAR(std::acos(-held[0].ray_direction.y()) * 180 / M_PI, 70.0, 1.0);
+  // An arm hanging 25 degrees out (a tracker's error, a hand on a hip) is
+  // outside the rest zone and extended; it is no pointing...
+  EXPECT_TRUE(spot(c, arm_stream(gesture(2.0, 25), 8)).empty());
+  // ...which only min_raise says: without it the same stream points at the feet.
+  SpotterOptions any_angle;
+  any_angle.min_raise = 0;
+  EXPECT_EQ(spot(c, arm_stream(gesture(2.0, 25), 8), any_angle).size(), 1u);
+}
+
+TEST(Spotting, APersonLostAndFoundSettlesAgain) {
+  const auto c = always_point();
+  const SpotterOptions o;
+  // The arm is up from 2.1 s, still by the hand's speed (over `window` s,
+  // smoothed) about 0.3 s later: the event goes out `aim` s after that.
+  const auto plain = spot(c, arm_stream(gesture(1.6, 70), 8));
+  ASSERT_EQ(plain.size(), 1u);
+  EXPECT_NEAR(plain[0].end_ns * 1e-9, 2.1 + 0.3 + o.aim, 0.1);
+  // The same with the person unseen from 1.0 to 1.6 s (lost by the trackers,
+  // found again under the same id): the hold counts only once the fresh
+  // skeletons have had `warmup` s to settle.
+  const auto after_gap = spot(c, arm_stream(gesture(1.6, 70), 8, 1.0, 1.6));
+  ASSERT_EQ(after_gap.size(), 1u);
+  EXPECT_NEAR(after_gap[0].end_ns * 1e-9, 1.6 + o.warmup + o.aim, 0.05);
+  // A gap shorter than `lost` (dropped frames) changes nothing.
+  const auto short_gap = spot(c, arm_stream(gesture(1.6, 70), 8, 1.0, 1.2));
+  ASSERT_EQ(short_gap.size(), 1u);
+  EXPECT_EQ(short_gap[0].end_ns, plain[0].end_ns);
 }

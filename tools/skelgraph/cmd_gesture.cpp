@@ -646,6 +646,19 @@ void add_model_options(CLI::App* c, GestureOptions& o) {
   c->add_option("--threads", o.threads, "worker threads (default 2)")->check(CLI::Range(1, 64));
 }
 
+// The spotter's settings, the same on `gesture spot` and `gesture sim`.
+void add_spotter_options(CLI::App* c, GestureOptions& o) {
+  c->add_option("--hold", o.spot.hold, "s an extended arm is held before pointing is tried (default 0.25)")->check(CLI::Range(0.0, 5.0));
+  c->add_option("--aim", o.spot.aim,
+                "s of the hold the pointing ray is averaged over, at most: the event goes out when the arm moves again or then "
+                "(default 1.5; at most --hold: at once, from a --hold look)")
+      ->check(CLI::Range(0.0, 10.0));
+  c->add_option("--still-speed", o.spot.still_speed, "m/s below which a hand is still (default 0.25)")->check(CLI::Range(0.01, 5.0));
+  c->add_option("--min-raise", o.spot.min_raise,
+                "degrees from hanging straight down an extended arm must be raised to count as a pointing hold (default 35)")
+      ->check(CLI::Range(0.0, 180.0));
+}
+
 }  // namespace
 
 void add_gesture_command(CLI::App& app, GlobalOptions&, Action& run) {
@@ -689,12 +702,7 @@ void add_gesture_command(CLI::App& app, GlobalOptions&, Action& run) {
                  "below the shoulders, held, raised over 0.5 s into the next clip (default 0: none)")
       ->check(CLI::Range(0.0, 10.0));
   sp->add_option("--gap", o->gap, "s of the last frame held between clips (default 0: the clips' own idle starts and ends are the rest)")->check(CLI::Range(0.0, 10.0));
-  sp->add_option("--hold", o->spot.hold, "s an extended arm is held before pointing is tried (default 0.25)")->check(CLI::Range(0.0, 5.0));
-  sp->add_option("--aim", o->spot.aim,
-                 "s of the hold the pointing ray is averaged over, at most: the event goes out when the arm moves again or then "
-                 "(default 1.5; at most --hold: at once, from a --hold look)")
-      ->check(CLI::Range(0.0, 10.0));
-  sp->add_option("--still-speed", o->spot.still_speed, "m/s below which a hand is still (default 0.25)")->check(CLI::Range(0.01, 5.0));
+  add_spotter_options(sp, *o);
   sp->callback([o, &run] { run = [o] { return gesture_spot(*o); }; });
 
   auto* sm = g->add_subcommand("sim", "Simulated pointing sessions (no outside data): train a classifier on some, spot "
@@ -704,12 +712,7 @@ void add_gesture_command(CLI::App& app, GlobalOptions&, Action& run) {
   sm->add_option("--train-sessions", o->train_sessions, "sessions to train on (default 8)")->check(CLI::Range(1, 200));
   sm->add_option("--test-sessions", o->test_sessions, "sessions to spot on (default 4)")->check(CLI::Range(1, 200));
   sm->add_option("--out", o->out, "write the trained classifier (JSON), e.g. for the gesture component");
-  sm->add_option("--hold", o->spot.hold, "s an extended arm is held before pointing is tried (default 0.25)")->check(CLI::Range(0.0, 5.0));
-  sm->add_option("--aim", o->spot.aim,
-                 "s of the hold the pointing ray is averaged over, at most: the event goes out when the arm moves again or then "
-                 "(default 1.5; at most --hold: at once, from a --hold look)")
-      ->check(CLI::Range(0.0, 10.0));
-  sm->add_option("--still-speed", o->spot.still_speed, "m/s below which a hand is still (default 0.25)")->check(CLI::Range(0.01, 5.0));
+  add_spotter_options(sm, *o);
   sm->add_option("--window", o->spot.window, "s over which hand speed is measured (default 0.25)")->check(CLI::Range(0.03, 2.0));
   sm->callback([o, &run] { run = [o] { return gesture_sim(*o); }; });
 

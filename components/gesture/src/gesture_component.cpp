@@ -63,6 +63,7 @@ runtime::ComponentInfo GestureComponent::describe() {
                   "again or then (at most hold_s: at once)",
                   0.0, 10.0)
       .add_double("still_speed", 0.25, "a hand slower than this is still, m/s", 0.01, 5.0)
+      .add_double("min_raise_deg", 35.0, "an extended arm counts as pointing only raised this far from hanging straight down", 0.0, 180.0)
       .add_double("person_timeout_ms", 2000.0, "a person not seen this long is forgotten", 10.0, 60000.0);
   return info;
 }
@@ -79,6 +80,7 @@ GestureComponent::GestureComponent(runtime::Context& ctx, const runtime::Params&
   options_.hold = params.get<double>("hold_s");
   options_.aim = params.get<double>("aim_s");
   options_.still_speed = params.get<double>("still_speed");
+  options_.min_raise = params.get<double>("min_raise_deg");
   options_.surfaces.clear();
   // On a command line a list is split at commas, which also splits "name:x,y,z":
   // a piece without a name (no ':') continues the one before it.

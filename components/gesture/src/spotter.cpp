@@ -116,7 +116,9 @@ std::vector<SpottedEvent> Spotter::step(const skeleton::Skeleton& s, const Wrist
   std::vector<SpottedEvent> out;
   person_ = s.person_id;
   const std::int64_t t = s.stamp_ns;
-  if (first_ns_ < 0) first_ns_ = t;
+  // A person unseen for `lost` s was lost by the trackers and found again (a
+  // fused id outlives that): the fresh skeletons settle again, as at the start.
+  if (first_ns_ < 0 || (have_last_ && static_cast<double>(t - last_ns_) * 1e-9 > o_.lost)) first_ns_ = t;
   // The pointing event gathered over the hold goes out: at `aim` (moving:
   // false), or when the arm moves again, without the hold's last `window` s,
   // when the hand was already on its way (the speed is measured over that
@@ -169,7 +171,10 @@ std::vector<SpottedEvent> Spotter::step(const skeleton::Skeleton& s, const Wrist
     at_rest[side] = ha.y() < sh.y() - o_.rest_drop * len && reach.norm() < o_.rest_reach * len;
     still[side] = speed_[side] < o_.still_speed;
     const bool settled = static_cast<double>(t - first_ns_) * 1e-9 >= o_.warmup;
-    const bool extended = settled && !at_rest[side] && (ha - sh).norm() >= o_.extended * len;
+    // Extended and raised: an arm hanging straight is no pointing, even where a
+    // tracker's error puts its hand outside the rest zone.
+    const double raised = std::acos(std::clamp((sh.y() - ha.y()) / std::max((ha - sh).norm(), 1e-9), -1.0, 1.0));
+    const bool extended = settled && !at_rest[side] && (ha - sh).norm() >= o_.extended * len && raised >= o_.min_raise * M_PI / 180;
     if (still[side] && extended) {
       if (hold_since_[side] < 0) {
         hold_since_[side] = t;

@@ -67,8 +67,10 @@ struct SpotterOptions {
   double pad = 0.17;           // s of frames before the segment opened that go with it
   double hold = 0.25;          // s an extended arm must be held before pointing is tried
   double aim = 1.5;            // s of the hold the ray is averaged over, at most (<= hold: the event at once)
-  double warmup = 1.0;         // s after a person's first skeleton before a hold counts (a fresh track is still settling)
-  double extended = 0.80;      // shoulder -> hand share of the arm's length that counts as extended
+  double warmup = 1.0;         // s after a person's first skeleton before a hold counts (a fresh track is still settling)...
+  double lost = 0.3;           // ...and after a gap of more than this many s in the person's skeletons (lost and found again)
+  double extended = 0.80;      // shoulder -> hand share of the arm's length that counts as extended...
+  double min_raise = 35.0;     // ...with the shoulder -> hand line at least this many degrees from hanging straight down
   double min_length = 0.4;     // s: shorter segments are ignored
   double max_length = 10.0;    // s: longer ones are cut (classified and reopened)
   std::string point_label = "point";
@@ -141,7 +143,7 @@ class Spotter {
   Eigen::Vector3d last_hand_[2];  // smoothed
   std::deque<std::pair<std::int64_t, Eigen::Vector3d>> trail_[2];
   bool have_last_ = false;
-  std::int64_t first_ns_ = -1;  // the person's first skeleton
+  std::int64_t first_ns_ = -1;  // the person's first skeleton, or the first after a gap
   MotionState state_ = MotionState::Resting;
   // Ray samples of the current hold per arm (origin, direction).
   Rays rays_[2];
