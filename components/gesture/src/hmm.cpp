@@ -98,14 +98,6 @@ void GaussianMixture::log_pdf_components(const VectorXd& x, VectorXd& out) const
   }
 }
 
-void GaussianMixture::log_pdf_components(const MatrixXd& X, Eigen::Ref<MatrixXd> out) const {
-  for (Eigen::Index k = 0; k < log_norm_.size(); ++k) {
-    const auto ku = static_cast<std::size_t>(k);
-    const MatrixXd Z = (X.rowwise() - means[ku].transpose()) * inv_l_[ku].transpose();
-    out.col(k) = (log_norm_(k) - 0.5 * Z.rowwise().squaredNorm().array()).matrix();
-  }
-}
-
 double GaussianMixture::log_pdf(const VectorXd& x) const {
   VectorXd c;
   log_pdf_components(x, c);
@@ -318,7 +310,6 @@ std::vector<int> Hmm::viterbi(const Sequence& x, double* log_prob) const {
     if (log_prob) *log_prob = 0;
     return path;
   }
-  if (x.cols() != dim_) throw ModelError("sequence has " + std::to_string(x.cols()) + " features per frame, the model " + std::to_string(dim_));
   Pass::Rows comp(T, offsets_.back()), logb(T, N);
   emissions_of(x, comp, logb);
   MatrixXd delta(T, N);

@@ -34,8 +34,6 @@ struct GaussianMixture {
   void prepare();
   double log_pdf(const Eigen::VectorXd& x) const;                      // log sum_m w_m N(x; mu_m, S_m)
   void log_pdf_components(const Eigen::VectorXd& x, Eigen::VectorXd& out) const;  // log w_m + log N_m
-  // log w_m + log N_m(x_t) for every frame (row) of X at once: out is T x M.
-  void log_pdf_components(const Eigen::MatrixXd& X, Eigen::Ref<Eigen::MatrixXd> out) const;
   // After prepare(): component m's inverse covariance and log w_m + its log normaliser.
   Eigen::MatrixXd precision(std::size_t m) const { return inv_l_[m].transpose() * inv_l_[m]; }
   double log_norm(std::size_t m) const { return log_norm_(static_cast<Eigen::Index>(m)); }
