@@ -301,6 +301,16 @@ TEST(Classifier, HandFeaturesNeedWristsAndStayOffline) {
   EXPECT_NE(why.find("need wrist joints; this skeleton stream carries none"), std::string::npos) << why;
   const Wrists w;
   EXPECT_EQ(error_of([&] { spotter.step(frame, &w); }), "");
+  // The 'arm' features model the active arm only: the clip must be made right-handed first.
+  o.features.set = FeatureSet::Arm;
+  for (const auto hands : {Hands::AsIs, Hands::Augment}) {
+    o.hands = hands;
+    EXPECT_NE(error_of([&] { Classifier::train(clips, three_classes(), o); }).find("needs --hands canonical"), std::string::npos);
+  }
+  o.hands = Hands::Canonical;
+  const auto arm = Classifier::train(clips, three_classes(), o);
+  EXPECT_EQ(arm.models().front().dim(), 8);  // the right arm's 5 values and 3 speeds
+  EXPECT_EQ(arm.classify(clips.front().x).scores.size(), 3u);
 }
 
 TEST(Metrics, MatchHandCountedValues) {

@@ -405,3 +405,41 @@ TEST(Features, HandsUseTheWristsWhenGiven) {
   EXPECT_EQ(n.x(0, 8), 0.0);
   EXPECT_THROW(features_of({pose(e, h, 0), pose(e, h, 1)}, o, &wrists), std::invalid_argument);  // one wrist per frame
 }
+
+TEST(Features, ArmModelsSeeTheActiveArmAndItsHand) {
+  const auto names = feature_names(FeatureSet::Arm);
+  ASSERT_EQ(names.size(), 16u);  // per arm 2 angles + forearm out, per arm hand forward + sway, speeds of the first 6
+  EXPECT_EQ(names[6], "left_hand_forward");
+  EXPECT_EQ(names[9], "right_hand_sway");
+  EXPECT_TRUE(needs_wrists(FeatureSet::Arm));
+  EXPECT_TRUE(one_arm(FeatureSet::Arm));
+  EXPECT_FALSE(one_arm(FeatureSet::Hands));
+  // The right arm held forward (+z is forward for this pose's shoulders), the hand segment 0.1 m further on.
+  const Eigen::Vector3d e(-0.2, 1.4, 2.3), h(-0.2, 1.4, 2.65);
+  Wrists w;
+  w.right = {-0.2, 1.4, 2.55};  // upper arm 0.3 m + forearm 0.25 m
+  w.left = {0.2, 0.95, 2};
+  FeatureOptions o;
+  o.set = FeatureSet::Arm;
+  // A hand waved from the wrist: the segment turns out, in, out, ... every
+  // frame for a second; then held out; in the last frame it points forward.
+  std::vector<Skeleton> frames;
+  std::vector<Wrists> wrists;
+  for (int i = 0; i < 60; ++i) {
+    const double side = i < 30 && i % 2 ? 0.1 : -0.1;  // out is -x on the right
+    frames.push_back(pose(e, w.right + Eigen::Vector3d(side, 0, 0), i * 33'333'333LL));
+    wrists.push_back(w);
+  }
+  frames.back() = pose(e, h, 59 * 33'333'333LL);
+  const auto f = features_of(frames, o, &wrists);
+  EXPECT_NEAR(f.x(59, 8), 0.1 / 0.55, 1e-9);  // right hand forward, in arm lengths
+  EXPECT_NEAR(f.x(0, 9), 0.0, 1e-12);          // sway: one frame has no spread
+  EXPECT_NEAR(f.x(29, 9), 1.0, 0.05);          // +-1 in turn over the last 0.5 s
+  EXPECT_NEAR(f.x(58, 9), 0.0, 1e-9);          // still (hand out, -x) for the last 0.5 s
+  EXPECT_GT(f.x(59, 9), 0.1);                  // the last frame turns it forward: spread again
+  // The model sees the right arm only.
+  const Sequence v = model_view(f.x, FeatureSet::Arm);
+  ASSERT_EQ(v.cols(), 8);
+  EXPECT_EQ(v(59, 3), f.x(59, 8));  // right_upper_arm_angle, forearm_angle, forearm_out, hand_forward, ...
+  EXPECT_EQ(model_view(f.x, FeatureSet::Hands).cols(), 16);
+}

@@ -626,8 +626,8 @@ void add_common(CLI::App* c, GestureOptions& o, bool model_options) {
 }
 
 void add_model_options(CLI::App* c, GestureOptions& o) {
-  c->add_option("--features", o.features, "feature set: thesis8 (default; the thesis's 8), extended, body, hands (needs wrists: Kinect v1/v2 recordings)")
-      ->check(CLI::IsMember({"body", "thesis8", "extended", "hands"}));
+  c->add_option("--features", o.features, "feature set: thesis8 (default; the thesis's 8), extended, body, hands, arm (hands and arm need wrists: Kinect v1/v2 recordings)")
+      ->check(CLI::IsMember({"body", "thesis8", "extended", "hands", "arm"}));
   c->add_option("--states", o.states, "HMM states (default 7)")->check(CLI::Range(1, 50));
   c->add_option("--mixtures", o.mixtures, "Gaussians per state (default 1)")->check(CLI::Range(1, 20));
   c->add_option("--garbage-mixtures", o.garbage_mixtures, "Gaussians per state of the garbage model (default: --mixtures)")
@@ -690,8 +690,8 @@ void add_gesture_command(CLI::App& app, GlobalOptions&, Action& run) {
 
   auto* f = g->add_subcommand("features", "Print the per-frame features of recordings as CSV (what the models see)");
   add_common(f, *o, false);
-  f->add_option("--features", o->features, "feature set: thesis8 (default; the thesis's 8), extended, body, hands (needs wrists: Kinect v1/v2 recordings)")
-      ->check(CLI::IsMember({"body", "thesis8", "extended", "hands"}));
+  f->add_option("--features", o->features, "feature set: thesis8 (default; the thesis's 8), extended, body, hands, arm (hands and arm need wrists: Kinect v1/v2 recordings)")
+      ->check(CLI::IsMember({"body", "thesis8", "extended", "hands", "arm"}));
   f->callback([o, &run] { run = [o] { return gesture_features(*o); }; });
 
   auto* sp = g->add_subcommand("spot", "Spot gestures in continuous streams of recorded clips: each subject's clips one "

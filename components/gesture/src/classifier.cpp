@@ -49,8 +49,10 @@ double quantile(std::vector<double> v, double q) {
   return i + 1 < v.size() ? v[i] * (1 - f) + v[i + 1] * f : v[i];
 }
 
-// The sequence a model sees: the clip, right-handed when asked.
-Sequence prepared(const Sequence& x, Hands hands, FeatureSet set) { return hands == Hands::Canonical ? right_handed(x, set) : x; }
+// The sequence a model sees: the clip, right-handed when asked, its active arm only for one-arm sets.
+Sequence prepared(const Sequence& x, Hands hands, FeatureSet set) {
+  return model_view(hands == Hands::Canonical ? right_handed(x, set) : x, set);
+}
 
 struct Models {
   std::vector<Hmm> hmms;
@@ -60,13 +62,16 @@ struct Models {
 
 // Models only, no threshold.
 Models train_models(const std::vector<const Clip*>& clips, const ClassMap& map, const ClassifierOptions& o) {
+  if (one_arm(o.features.set) && o.hands != Hands::Canonical)
+    throw ModelError(std::string("the '") + feature_set_name(o.features.set) +
+                     "' features model the active arm only, which needs --hands canonical (the clip made right-handed)");
   // One group of sequences per model, in class order, then action order.
   std::map<std::pair<int, std::string>, std::vector<Sequence>> groups;
   for (const Clip* c : clips) {
     if (c->label < 0) continue;
     auto& g = groups[{c->label, o.per_action ? c->action : std::string()}];
     g.push_back(prepared(c->x, o.hands, o.features.set));
-    if (o.hands == Hands::Augment) g.push_back(mirrored(c->x, o.features.set));
+    if (o.hands == Hands::Augment) g.push_back(model_view(mirrored(c->x, o.features.set), o.features.set));
     if (o.prefixes)  // what a live spotter sees before the gesture ends
       for (double share : {0.5, 0.7}) {
         const auto n = static_cast<Eigen::Index>(share * static_cast<double>(c->x.rows()));

@@ -26,10 +26,13 @@ double to_vertical(const Vector3d& v) {
 }
 
 // Per-arm values of the angle sets (thesis8, extended, hands).
-enum ArmValue { UpperArmAngle, ForearmAngle, ElbowBend, HandHeight, HandAngle, HandLength, ForearmOut, kArmValues };
+enum ArmValue { UpperArmAngle, ForearmAngle, ElbowBend, HandHeight, HandAngle, HandLength, ForearmOut, HandForward, HandSway, kArmValues };
 constexpr const char* kArmValueNames[kArmValues] = {"upper_arm_angle", "forearm_angle", "elbow_bend",
                                                     "hand_height",     "hand_angle",    "hand_length",
-                                                    "forearm_out"};
+                                                    "forearm_out",     "hand_forward",  "hand_sway"};
+// HandSway is the spread (standard deviation) of the hand segment's outward
+// direction over the last kSwayWindow s: a hand waved from the wrist swings it.
+constexpr double kSwayWindow = 0.5;
 
 // The values of a set (before speeds), and which of them get a speed.
 struct Layout {
@@ -46,6 +49,7 @@ std::vector<std::vector<ArmValue>> arm_blocks(FeatureSet s, int* speed_blocks) {
   switch (s) {
     case FeatureSet::Extended: return {{UpperArmAngle, ForearmAngle}, {ElbowBend, HandHeight}};
     case FeatureSet::Hands: return {{UpperArmAngle, ForearmAngle, ForearmOut}, {HandAngle, HandLength}};
+    case FeatureSet::Arm: return {{UpperArmAngle, ForearmAngle, ForearmOut}, {HandForward, HandSway}};
     default: return {{UpperArmAngle, ForearmAngle}};
   }
 }
@@ -140,6 +144,17 @@ VectorXd frame_values(const std::vector<std::pair<int, int>>& arm_layout, int n,
       if (wr.allFinite() && forearm.norm() > 1e-9 && hand.norm() > 1e-9) {
         v[HandAngle] = to_vertical(hand);
         v[HandLength] = hand.norm() / forearm.norm();
+        // The hand segment in the body's frame: forward (horizontal, square to
+        // the shoulders) in arm lengths, and its outward direction (HandSway's spread).
+        Vector3d across = s[JointId::RightShoulder].position - s[JointId::LeftShoulder].position;
+        across.y() = 0;
+        const double len = (el - sh).norm() + forearm.norm();
+        if (good(JointId::LeftShoulder) && good(JointId::RightShoulder) && good(arm.shoulder) && across.norm() > 1e-6 && len > 1e-9) {
+          across.normalize();
+          const Vector3d forward = Vector3d::UnitY().cross(across);
+          v[HandForward] = hand.dot(forward) / len;
+          v[HandSway] = hand.normalized().dot(side == 0 ? Vector3d(-across) : across);
+        }
       }
     }
   }
@@ -216,6 +231,7 @@ std::optional<FeatureSet> feature_set_from_name(const std::string& name) {
   if (name == "extended") return FeatureSet::Extended;
   if (name == "body") return FeatureSet::Body;
   if (name == "hands") return FeatureSet::Hands;
+  if (name == "arm") return FeatureSet::Arm;
   return std::nullopt;
 }
 
@@ -225,6 +241,7 @@ const char* feature_set_name(FeatureSet set) {
     case FeatureSet::Extended: return "extended";
     case FeatureSet::Body: return "body";
     case FeatureSet::Hands: return "hands";
+    case FeatureSet::Arm: return "arm";
   }
   return "?";
 }
@@ -232,6 +249,8 @@ const char* feature_set_name(FeatureSet set) {
 FeatureStream::FeatureStream(FeatureOptions options) : o_(options) {
   const Layout l = layout(options.set);
   arm_ = l.arm;
+  for (std::size_t i = 0; i < arm_.size(); ++i)
+    if (arm_[i].second == HandSway) sway_.push_back({static_cast<int>(i), {}});
   values_ = static_cast<int>(l.values.size());
   speeds_ = l.speeds;
   signed_speed_ = l.signed_speed;
@@ -243,11 +262,25 @@ void FeatureStream::reset() {
   have_.assign(static_cast<std::size_t>(values_), false);
   first_ = true;
   last_dt_ = 1.0 / 30;
+  for (auto& w : sway_) w.second.clear();
 }
 
 int FeatureStream::size() const { return values_ + speeds_; }
 
-bool needs_wrists(FeatureSet set) { return set == FeatureSet::Hands; }
+bool needs_wrists(FeatureSet set) { return set == FeatureSet::Hands || set == FeatureSet::Arm; }
+
+bool one_arm(FeatureSet set) { return set == FeatureSet::Arm; }
+
+Sequence model_view(const Sequence& x, FeatureSet set) {
+  if (!one_arm(set)) return x;
+  const auto names = feature_names(set);
+  std::vector<Eigen::Index> keep;
+  for (std::size_t i = 0; i < names.size(); ++i)
+    if (names[i].rfind("left_", 0) != 0) keep.push_back(static_cast<Eigen::Index>(i));
+  Sequence out(x.rows(), static_cast<Eigen::Index>(keep.size()));
+  for (std::size_t i = 0; i < keep.size(); ++i) out.col(static_cast<Eigen::Index>(i)) = x.col(keep[i]);
+  return out;
+}
 
 VectorXd FeatureStream::step(const skeleton::Skeleton& s, bool* complete, VectorXd* raw, const Wrists* wrists) {
   const VectorXd a = frame_values(arm_, values_, o_.set, s, wrists, o_.min_confidence);
@@ -269,6 +302,16 @@ VectorXd FeatureStream::step(const skeleton::Skeleton& s, bool* complete, Vector
       out(i) = last_good_(i);  // held (0 until a good value has been seen); its speed is 0
     }
     if (i < speeds_) out(values_ + i) = signed_speed_ ? speed : std::abs(speed);
+  }
+  // HandSway: the direction's spread over the last kSwayWindow s (held values included; 0 on the first frame).
+  for (auto& [i, window] : sway_) {
+    window.emplace_back(s.stamp_ns, out(i));
+    while (window.size() > 1 && static_cast<double>(s.stamp_ns - window.front().first) * 1e-9 > kSwayWindow) window.pop_front();
+    double mean = 0, sq = 0;
+    for (const auto& [t, v] : window) mean += v;
+    mean /= static_cast<double>(window.size());
+    for (const auto& [t, v] : window) sq += (v - mean) * (v - mean);
+    out(i) = std::sqrt(sq / static_cast<double>(window.size()));
   }
   last_ns_ = s.stamp_ns;
   last_dt_ = dt;

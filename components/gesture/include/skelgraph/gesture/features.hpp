@@ -26,6 +26,16 @@
 // a pointing finger makes it longer); then the speeds of the first six.
 // Signal-to-stop and push-a-button hold the arm forward like pointing; the
 // hand tells them apart.
+// Arm (Kinect v1/v2 recordings, offline, like hands): per arm the thesis's two
+// angles and forearm_out, as in hands; then per arm the hand segment's
+// forward reach (hand - wrist along the body's forward axis, in arm lengths:
+// a pointing finger stretches towards the target, a pushing fist or flat
+// palm does not) and its sway (the standard deviation, over the last 0.5 s,
+// of the hand segment's direction along the outward axis: a hand waved from
+// the wrist swings it, a raised one does not); then the speeds of the first
+// six. Models see only the active arm: clips are made right-handed and the
+// left arm's columns dropped (model_view), so the way a subject holds the
+// other arm does not count.
 //
 // Missing joints: a frame where a joint an angle needs is below the minimum
 // confidence keeps that angle's last good value (its speed is then 0) and is
@@ -35,6 +45,8 @@
 // count as min_interval.
 
 #include <cmath>
+#include <cstdint>
+#include <deque>
 #include <optional>
 #include <utility>
 #include <string>
@@ -47,7 +59,7 @@
 
 namespace skelgraph::gesture {
 
-enum class FeatureSet { Thesis8, Extended, Body, Hands };
+enum class FeatureSet { Thesis8, Extended, Body, Hands, Arm };
 
 struct FeatureOptions {
   FeatureSet set = FeatureSet::Thesis8;
@@ -61,7 +73,11 @@ struct Wrists {
   Eigen::Vector3d left = Eigen::Vector3d::Constant(std::nan("")), right = Eigen::Vector3d::Constant(std::nan(""));
 };
 bool needs_wrists(FeatureSet set);  // without them its wrist values are missing in every frame
-std::optional<FeatureSet> feature_set_from_name(const std::string& name);  // "thesis8", "extended", "body", "hands"
+// Sets whose models see one arm only: the right one of a right-handed clip.
+bool one_arm(FeatureSet set);
+// The columns of a (right-handed) clip a model of `set` sees: without the left arm's for one_arm sets, else all.
+Sequence model_view(const Sequence& x, FeatureSet set);
+std::optional<FeatureSet> feature_set_from_name(const std::string& name);  // "thesis8", "extended", "body", "hands", "arm"
 const char* feature_set_name(FeatureSet set);
 // Column i of a mirrored sequence is column perm[i] of the original: left and right swapped.
 std::vector<int> mirror_permutation(FeatureSet set);
@@ -102,6 +118,7 @@ class FeatureStream {
   std::int64_t last_ns_ = 0;
   double last_dt_ = 1.0 / 30;
   bool first_ = true;
+  std::vector<std::pair<int, std::deque<std::pair<std::int64_t, double>>>> sway_;  // arm: each sway column's recent values
 };
 
 struct Features {
