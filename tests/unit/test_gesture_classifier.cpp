@@ -311,6 +311,11 @@ TEST(Classifier, HandFeaturesNeedWristsAndStayOffline) {
   const auto arm = Classifier::train(clips, three_classes(), o);
   EXPECT_EQ(arm.models().front().dim(), 8);  // the right arm's 5 values and 3 speeds
   EXPECT_EQ(arm.classify(clips.front().x).scores.size(), 3u);
+  // Saved and loaded, it classifies the same; a file claiming other hands is refused.
+  auto j = arm.to_json();
+  EXPECT_EQ(Classifier::from_json(j).classify(clips.front().x).scores, arm.classify(clips.front().x).scores);
+  j["hands"] = "as-is";
+  EXPECT_NE(error_of([&] { Classifier::from_json(j); }).find("'arm' models need 'hands': \"canonical\""), std::string::npos);
 }
 
 TEST(Metrics, MatchHandCountedValues) {

@@ -319,11 +319,13 @@ Classifier Classifier::from_json(const nlohmann::json& j) {
     throw ModelError(std::string("classifier: ") + e.what());
   }
   const auto set = feature_set_from_name(need("features").is_string() ? need("features").get<std::string>() : "");
-  if (!set) throw ModelError("classifier: 'features' must be thesis8, extended or body");
+  if (!set) throw ModelError("classifier: 'features' must be thesis8, extended, body, hands or arm");
   c.features_ = *set;
   const auto hands = hands_from_name(need("hands").is_string() ? need("hands").get<std::string>() : "");
   if (!hands) throw ModelError("classifier: 'hands' must be canonical, augment or as-is");
   c.hands_ = *hands;
+  if (one_arm(c.features_) && c.hands_ != Hands::Canonical)
+    throw ModelError(std::string("classifier: '") + feature_set_name(c.features_) + "' models need 'hands': \"canonical\"");
   if (!need("trimmed").is_boolean()) throw ModelError("classifier: 'trimmed' must be true or false");
   c.trimmed_ = need("trimmed").get<bool>();
   if (j.contains("pointing_correction")) {
@@ -345,7 +347,7 @@ Classifier Classifier::from_json(const nlohmann::json& j) {
   if (c.garbage_ < -1 || c.garbage_ >= K) throw ModelError("classifier: 'garbage' is not a label index or -1");
   const auto& models = need("models");
   if (!models.is_array() || models.empty()) throw ModelError("classifier: 'models' must be a non-empty array");
-  const int dim = static_cast<int>(feature_names(c.features_).size());
+  const int dim = static_cast<int>(model_columns(c.features_).size());
   std::vector<bool> has(static_cast<std::size_t>(K), false);
   for (std::size_t i = 0; i < models.size(); ++i) {
     const std::string where = "classifier: models[" + std::to_string(i) + "]";
@@ -361,7 +363,7 @@ Classifier Classifier::from_json(const nlohmann::json& j) {
     }
     if (c.models_.back().dim() != dim)
       throw ModelError(where + " has " + std::to_string(c.models_.back().dim()) + " features; '" + feature_set_name(c.features_) +
-                       "' has " + std::to_string(dim));
+                       "' models have " + std::to_string(dim));
     c.model_class_.push_back(k);
     c.model_action_.push_back(e.value("action", std::string()));
     has[static_cast<std::size_t>(k)] = true;

@@ -271,12 +271,17 @@ bool needs_wrists(FeatureSet set) { return set == FeatureSet::Hands || set == Fe
 
 bool one_arm(FeatureSet set) { return set == FeatureSet::Arm; }
 
-Sequence model_view(const Sequence& x, FeatureSet set) {
-  if (!one_arm(set)) return x;
+std::vector<Eigen::Index> model_columns(FeatureSet set) {
   const auto names = feature_names(set);
   std::vector<Eigen::Index> keep;
   for (std::size_t i = 0; i < names.size(); ++i)
-    if (names[i].rfind("left_", 0) != 0) keep.push_back(static_cast<Eigen::Index>(i));
+    if (!one_arm(set) || names[i].rfind("left_", 0) != 0) keep.push_back(static_cast<Eigen::Index>(i));
+  return keep;
+}
+
+Sequence model_view(const Sequence& x, FeatureSet set) {
+  if (!one_arm(set)) return x;
+  const auto keep = model_columns(set);
   Sequence out(x.rows(), static_cast<Eigen::Index>(keep.size()));
   for (std::size_t i = 0; i < keep.size(); ++i) out.col(static_cast<Eigen::Index>(i)) = x.col(keep[i]);
   return out;

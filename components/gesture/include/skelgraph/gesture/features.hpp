@@ -76,6 +76,7 @@ bool needs_wrists(FeatureSet set);  // without them its wrist values are missing
 // Sets whose models see one arm only: the right one of a right-handed clip.
 bool one_arm(FeatureSet set);
 // The columns of a (right-handed) clip a model of `set` sees: without the left arm's for one_arm sets, else all.
+std::vector<Eigen::Index> model_columns(FeatureSet set);
 Sequence model_view(const Sequence& x, FeatureSet set);
 std::optional<FeatureSet> feature_set_from_name(const std::string& name);  // "thesis8", "extended", "body", "hands", "arm"
 const char* feature_set_name(FeatureSet set);
