@@ -71,7 +71,7 @@ Models train_models(const std::vector<const Clip*>& clips, const ClassMap& map, 
     if (c->label < 0) continue;
     auto& g = groups[{c->label, o.per_action ? c->action : std::string()}];
     g.push_back(prepared(c->x, o.hands, o.features.set));
-    if (o.hands == Hands::Augment) g.push_back(model_view(mirrored(c->x, o.features.set), o.features.set));
+    if (o.hands == Hands::Augment) g.push_back(mirrored(c->x, o.features.set));  // (one-arm sets are refused above)
     if (o.prefixes)  // what a live spotter sees before the gesture ends
       for (double share : {0.5, 0.7}) {
         const auto n = static_cast<Eigen::Index>(share * static_cast<double>(c->x.rows()));

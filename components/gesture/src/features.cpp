@@ -25,7 +25,7 @@ double to_vertical(const Vector3d& v) {
   return std::acos(std::clamp(v.y() / n, -1.0, 1.0));
 }
 
-// Per-arm values of the angle sets (thesis8, extended, hands).
+// Per-arm values of the angle sets (thesis8, extended, hands, arm).
 enum ArmValue { UpperArmAngle, ForearmAngle, ElbowBend, HandHeight, HandAngle, HandLength, ForearmOut, HandForward, HandSway, kArmValues };
 constexpr const char* kArmValueNames[kArmValues] = {"upper_arm_angle", "forearm_angle", "elbow_bend",
                                                     "hand_height",     "hand_angle",    "hand_length",
