@@ -110,7 +110,7 @@ void BagPlayer::run() {
         from = s.log_time;
         position_log_ = from;
         at_end_ = false;
-        player_->publish_state();
+        player_->sought();
         continue;
       }
       ++loops_;
@@ -129,7 +129,7 @@ void BagPlayer::run() {
         from = s.log_time;
         position_log_ = from;
         at_end_ = false;
-        player_->publish_state();
+        player_->sought();
       }
     }
     {  // let readers take (and reliable readers acknowledge) the last samples before the graph may stop

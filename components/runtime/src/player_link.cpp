@@ -43,6 +43,10 @@ void PlayerLink::on_request(const msg::PlayControl& c) {
       step_request_ = id;  // answered once the frames are out
       return;
     }
+    if (error.empty() && kind == K::Seek) {
+      seek_requests_.push_back(id);  // answered once the player is there
+      return;
+    }
   }
   publish_state(id, error);
 }
@@ -74,6 +78,16 @@ void PlayerLink::at_end() {
     pending = std::exchange(step_request_, "");
   }
   publish_state(pending, pending.empty() ? "" : "the recording ended before the steps were done");
+}
+
+void PlayerLink::sought() {
+  std::vector<std::string> answered;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    answered.swap(seek_requests_);
+  }
+  if (answered.empty()) publish_state();
+  for (const auto& id : answered) publish_state(id, "");
 }
 
 void PlayerLink::publish_state(const std::string& request_id, const std::string& error) {

@@ -3,7 +3,9 @@
 // an MCAP file): takes the requests on skelgraph/play/control meant for it
 // (target "" or its name; each request id once: requesters repeat a request
 // until it is answered), applies them to its PlayGate and answers on
-// skelgraph/play/state. A step is answered once its frames are out.
+// skelgraph/play/state. A step is answered once its frames are out, a seek
+// once the player is at the new position (so the answer, and any state read
+// after it, carries that position).
 //
 // Thread-safe: requests arrive on the executor; the player's own thread reads
 // the gate through with_gate() and reports delivered frames.
@@ -13,6 +15,7 @@
 #include <functional>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include "skelgraph/runtime/context.hpp"
 #include "skelgraph/runtime/play_gate.hpp"
@@ -53,6 +56,8 @@ class PlayerLink {
   void delivered();
   // At the end of the recording: answers a step request that cannot finish.
   void at_end();
+  // After the player has gone to a seek's position: answers the seek requests taken.
+  void sought();
   void publish_state(const std::string& request_id = "", const std::string& error = "");
 
  private:
@@ -67,6 +72,7 @@ class PlayerLink {
   PlayGate gate_;
   std::deque<std::string> handled_;  // the latest request ids
   std::string step_request_;         // answered when its steps are delivered
+  std::vector<std::string> seek_requests_;  // answered when the player is at the position (the latest seek wins)
   Publisher<msg::PlayState> state_pub_;
   Subscription<msg::PlayControl> control_sub_;
 };
