@@ -78,8 +78,9 @@ on() {
 }
 spawn() {
   local h=$1 out=$2 err=$3; shift 3
+  : >"$out"  # exists on return: a caller may read it before the background process has opened it
   ( SKELGRAPH_HOST="${SKELGRAPH_HOST:-$h}" exec ip netns exec "$NS$h" unshare -m bash -c 'mount --bind "$0" /dev/shm && cd "$1" && shift && exec "$@"' \
-      "$WORK/shm_$h" "$WORK/$h" "$@" >"$out" 2>>"$err" ) &
+      "$WORK/shm_$h" "$WORK/$h" "$@" >>"$out" 2>>"$err" ) &
   SPAWNED=$!
 }
 sg_args() { echo --profile "$CELL_PROFILE" --interface "$(addr "$1")" "${CELL_DDS_ARGS[@]}"; }
