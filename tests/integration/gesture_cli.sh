@@ -46,6 +46,13 @@ for a in Point-at-the-camera Push-an-imaginary-button Walk-in-place Raise-your-h
 json_check "$WORK/cv.json" 'sum(map(sum, d["metrics"]["confusion"])) == 50 and d["metrics"]["accuracy"] > 0.4 and len(d["clips"]) == 50 and d["folds"] == 2'
 grep -q "<svg" "$WORK/cm.svg" || fail "no SVG confusion matrix"
 ok "five-class 2-fold cross-validation: confusion matrix over 50 clips, SVG written"
+# The five-class set-up of the README: active-arm features, k-means initialisation, best of several restarts.
+"$S" gesture cv "$WORK/five" --classes five-class --split kfold --folds 2 --features arm --states 3 --covariance diag \
+  --init kmeans --restarts 4 --json >"$WORK/cv_km.json" 2>"$WORK/cv.err" || fail "gesture cv --init kmeans: $(cat "$WORK/cv.err")"
+json_check "$WORK/cv_km.json" 'd["config"]["init"] == "kmeans" and d["config"]["restarts"] == 4 and sum(map(sum, d["metrics"]["confusion"])) == 50 and d["metrics"]["accuracy"] > 0.4'
+"$S" gesture cv "$WORK/five" --classes five-class --init random 2>"$WORK/bad.err" && fail "--init random was accepted"
+grep -q "init" "$WORK/bad.err" || fail "--init random: $(cat "$WORK/bad.err")"
+ok "five-class with k-means initialisation and restarts; an unknown --init is refused"
 
 "$S" gesture features "$KG"/*p565_24-Point* >"$WORK/features.csv" || fail "gesture features"
 head -1 "$WORK/features.csv" | grep -q "right_forearm_angle_speed" || fail "features header: $(head -1 "$WORK/features.csv")"

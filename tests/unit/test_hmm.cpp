@@ -5,6 +5,7 @@
 // malformed models.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <random>
@@ -157,6 +158,70 @@ TEST(Hmm, BaumWelchFindsTheGeneratingStates) {
   const Hmm lr = Hmm::train(data, o);
   EXPECT_EQ(lr.transitions()(2, 0), 0.0);
   EXPECT_EQ(lr.emissions()[0].covs[0](0, 1), 0.0);
+}
+
+// States visited in no particular order: k-means initialisation puts a state
+// on each cluster of frames, with uniform start and transitions, before any
+// Baum-Welch iteration; cutting the sequences into equal parts would mix them.
+TEST(Hmm, KMeansInitialisationStartsAStateOnEachCluster) {
+  Hmm truth = three_states();
+  MatrixXd uniform = MatrixXd::Constant(3, 3, 1.0 / 3);
+  truth.set(VectorXd::Constant(3, 1.0 / 3), uniform, {gauss({0, 0}, 0.3), gauss({4, 0}, 0.3), gauss({0, 4}, 0.3)});
+  std::mt19937_64 rng(5);
+  std::vector<Sequence> data;
+  for (int i = 0; i < 30; ++i) data.push_back(sample(truth, 50, rng));
+  TrainOptions o;
+  o.states = 3;
+  o.covariance = Covariance::Diagonal;
+  o.max_iterations = 0;  // the initial model itself
+  const auto nearest = [](const Hmm& h, const VectorXd& want) {
+    double best = 1e9;
+    for (const auto& g : h.emissions()) best = std::min(best, (g.means[0] - want).norm());
+    return best;
+  };
+  const std::vector<VectorXd> centres = {(VectorXd(2) << 0, 0).finished(), (VectorXd(2) << 4, 0).finished(),
+                                         (VectorXd(2) << 0, 4).finished()};
+  o.init = Init::KMeans;
+  const Hmm k = Hmm::train(data, o);
+  for (const auto& c : centres) EXPECT_LT(nearest(k, c), 0.1);
+  EXPECT_NEAR(k.transitions()(0, 1), 1.0 / 3, 1e-12);
+  EXPECT_NEAR(k.start()(2), 1.0 / 3, 1e-12);
+  o.init = Init::Segments;
+  const Hmm seg = Hmm::train(data, o);
+  double worst = 0;
+  for (const auto& c : centres) worst = std::max(worst, nearest(seg, c));
+  EXPECT_GT(worst, 1.0);  // the control: equal parts of shuffled states start on mixtures of them
+}
+
+// restarts = R keeps, of R trainings from different seeds, the one with the
+// highest final training likelihood.
+TEST(Hmm, RestartsKeepTheBestFit) {
+  const Hmm truth = three_states();
+  std::mt19937_64 rng(11);
+  std::vector<Sequence> data;
+  for (int i = 0; i < 20; ++i) data.push_back(sample(truth, 30 + 3 * i, rng));
+  TrainOptions o;
+  o.states = 4;
+  o.init = Init::KMeans;
+  o.seed = 7;
+  o.restarts = 5;
+  TrainReport best;
+  const Hmm h = Hmm::train(data, o, &best);
+  std::vector<double> finals;
+  for (int r = 0; r < 5; ++r) {
+    TrainOptions one = o;
+    one.restarts = 1;
+    one.seed = o.seed + 0x9E3779B97F4A7C15ULL * static_cast<std::uint64_t>(r);
+    TrainReport rep;
+    Hmm::train(data, one, &rep);
+    finals.push_back(rep.log_likelihood.back());
+  }
+  const double top = *std::max_element(finals.begin(), finals.end());
+  EXPECT_DOUBLE_EQ(best.log_likelihood.back(), top);
+  EXPECT_GT(top, *std::min_element(finals.begin(), finals.end()));  // the seeds do differ, so the choice matters
+  double total = 0;
+  for (const auto& x : data) total += h.log_likelihood(x);
+  EXPECT_NEAR(total, top, 1e-6 * std::abs(top));
 }
 
 // The forward pass in log space, each emission straight from its Gaussians

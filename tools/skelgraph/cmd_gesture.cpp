@@ -39,6 +39,9 @@ struct GestureOptions {
   bool prefixes = false;
   double reject_quantile = 0.02;
   int iterations = 100;
+  double tolerance = 1e-4;
+  std::string init = "segments";
+  int restarts = 1;
   std::uint64_t seed = 1;
   int threads = 2;
   bool json = false;
@@ -49,7 +52,7 @@ struct GestureOptions {
   int folds = 5;
   std::string svg;
   std::vector<int> sweep_states, sweep_mixtures;
-  std::vector<std::string> sweep_covariance;
+  std::vector<std::string> sweep_covariance, sweep_init;
   bool sweep = false;
   bool nested = false;
   // sim
@@ -72,6 +75,9 @@ ClassifierOptions classifier_options(const GestureOptions& o) {
   c.hmm.mixtures = o.mixtures;
   c.hmm.covariance = o.covariance == "diag" ? Covariance::Diagonal : Covariance::Full;
   c.hmm.max_iterations = o.iterations;
+  c.hmm.tolerance = o.tolerance;
+  c.hmm.init = o.init == "kmeans" ? Init::KMeans : Init::Segments;
+  c.hmm.restarts = o.restarts;
   c.hmm.seed = o.seed;
   c.garbage_mixtures = o.garbage_mixtures;
   c.features.set = *feature_set_from_name(o.features);
@@ -107,12 +113,16 @@ std::string pct(double v) {
   return b;
 }
 
+const char* init_name(Init i) { return i == Init::KMeans ? "kmeans" : "segments"; }
+
 nlohmann::json config_json(const ClassifierOptions& c) {
   return {{"features", feature_set_name(c.features.set)},
           {"states", c.hmm.states},
           {"mixtures", c.hmm.mixtures},
           {"garbage_mixtures", c.garbage_mixtures > 0 ? c.garbage_mixtures : c.hmm.mixtures},
           {"covariance", c.hmm.covariance == Covariance::Full ? "full" : "diag"},
+          {"init", init_name(c.hmm.init)},
+          {"restarts", c.hmm.restarts},
           {"hands", hands_name(c.hands)},
           {"per_action", c.per_action},
           {"prefixes", c.prefixes},
@@ -170,21 +180,24 @@ int gesture_cv(const GestureOptions& o) {
     const std::vector<int> states = o.sweep_states.empty() ? std::vector<int>{3, 5, 7, 9} : o.sweep_states;
     const std::vector<int> mixtures = o.sweep_mixtures.empty() ? std::vector<int>{1, 2, 3} : o.sweep_mixtures;
     const std::vector<std::string> covs = o.sweep_covariance.empty() ? std::vector<std::string>{"full", "diag"} : o.sweep_covariance;
-    for (const auto& cov : covs)
-      for (int s : states)
-        for (int m : mixtures) {
-          auto c = base;
-          c.hmm.states = s;
-          c.hmm.mixtures = m;
-          c.hmm.covariance = cov == "diag" ? Covariance::Diagonal : Covariance::Full;
-          configs.push_back(c);
-        }
+    const std::vector<std::string> inits = o.sweep_init.empty() ? std::vector<std::string>{o.init} : o.sweep_init;
+    for (const auto& init : inits)
+      for (const auto& cov : covs)
+        for (int s : states)
+          for (int m : mixtures) {
+            auto c = base;
+            c.hmm.states = s;
+            c.hmm.mixtures = m;
+            c.hmm.covariance = cov == "diag" ? Covariance::Diagonal : Covariance::Full;
+            c.hmm.init = init == "kmeans" ? Init::KMeans : Init::Segments;
+            configs.push_back(c);
+          }
   } else {
     configs.push_back(base);
   }
   const auto config_name = [](const ClassifierOptions& c) {
     return std::to_string(c.hmm.states) + " states, " + std::to_string(c.hmm.mixtures) + " mixtures, " +
-           (c.hmm.covariance == Covariance::Full ? "full" : "diag");
+           (c.hmm.covariance == Covariance::Full ? "full" : "diag") + ", " + init_name(c.hmm.init) + " init";
   };
   std::vector<CvRun> runs;
   for (std::size_t i = 0; i < configs.size(); ++i) {
@@ -254,19 +267,21 @@ int gesture_cv(const GestureOptions& o) {
     return 0;
   }
   if (o.sweep) {
-    std::printf("%-6s %-7s %-9s %-9s %s\n", "states", "mixt.", "cov.", "accuracy", ("F1 " + map.classes[0]).c_str());
+    std::printf("%-6s %-7s %-9s %-9s %-9s %s\n", "states", "mixt.", "cov.", "init", "accuracy", ("F1 " + map.classes[0]).c_str());
     for (std::size_t i = 0; i < runs.size(); ++i) {
       const auto& r = runs[i];
-      std::printf("%-6d %-7d %-9s %-9s %.3f%s\n", r.config.hmm.states, r.config.hmm.mixtures,
-                  r.config.hmm.covariance == Covariance::Full ? "full" : "diag", pct(r.metrics.accuracy).c_str(), r.metrics.f1[0],
+      std::printf("%-6d %-7d %-9s %-9s %-9s %.3f%s\n", r.config.hmm.states, r.config.hmm.mixtures,
+                  r.config.hmm.covariance == Covariance::Full ? "full" : "diag", init_name(r.config.hmm.init),
+                  pct(r.metrics.accuracy).c_str(), r.metrics.f1[0],
                   i == best ? "  <- best" : "");
     }
     std::printf("\nbest configuration:\n");
   }
   const auto& m = win.metrics;
-  std::printf("%s, %zu clips, features %s, %d states, %d mixtures, %s covariance\n", split.c_str(), clips.size(),
-              feature_set_name(win.config.features.set), win.config.hmm.states, win.config.hmm.mixtures,
-              win.config.hmm.covariance == Covariance::Full ? "full" : "diagonal");
+  std::printf("%s, %zu clips, features %s, %d states, %d mixtures, %s covariance, %s initialisation%s\n", split.c_str(),
+              clips.size(), feature_set_name(win.config.features.set), win.config.hmm.states, win.config.hmm.mixtures,
+              win.config.hmm.covariance == Covariance::Full ? "full" : "diagonal", init_name(win.config.hmm.init),
+              win.config.hmm.restarts > 1 ? (", best of " + std::to_string(win.config.hmm.restarts) + " restarts").c_str() : "");
   std::printf("%s", confusion_text(m).c_str());
   std::printf("accuracy %s", pct(m.accuracy).c_str());
   std::printf("; %s precision %.3f recall %.3f F1 %.3f", m.labels[0].c_str(), m.precision[0], m.recall[0], m.f1[0]);
@@ -642,6 +657,16 @@ void add_model_options(CLI::App* c, GestureOptions& o) {
   c->add_option("--reject-quantile", o.reject_quantile, "share of held-out training clips the rejection threshold may reject (default 0.02)")
       ->check(CLI::Range(0.0, 1.0));
   c->add_option("--iterations", o.iterations, "Baum-Welch iteration cap (default 100)")->check(CLI::Range(1, 10000));
+  c->add_option("--init", o.init,
+                "first parameters: segments (default: each clip cut into equal parts, a state per part) or kmeans (k-means++ over "
+                "all frames, a state per cluster, uniform transitions)")
+      ->check(CLI::IsMember({"segments", "kmeans"}));
+  c->add_option("--restarts", o.restarts,
+                "train each model this many times from different seeds and keep the one that fits its training clips best "
+                "(default 1)")
+      ->check(CLI::Range(1, 100));
+  c->add_option("--tolerance", o.tolerance, "Baum-Welch stops when the log-likelihood per frame gains less (default 1e-4)")
+      ->check(CLI::Range(0.0, 1.0));
   c->add_option("--seed", o.seed, "seed for initialisation and folds (default 1)");
   c->add_option("--threads", o.threads, "worker threads (default 2)")->check(CLI::Range(1, 64));
 }
@@ -677,7 +702,7 @@ void add_gesture_command(CLI::App& app, GlobalOptions&, Action& run) {
       ->check(CLI::IsMember({"lso", "kfold"}));
   cv->add_option("--folds", o->folds, "k for --split kfold (default 5)")->check(CLI::Range(2, 1000));
   cv->add_option("--svg", o->svg, "write the confusion matrix as SVG");
-  cv->add_flag("--sweep", o->sweep, "try every states x mixtures x covariance combination and report the best");
+  cv->add_flag("--sweep", o->sweep, "try every states x mixtures x covariance (x initialisation) combination and report the best");
   cv->add_flag("--nested", o->nested,
                "with --sweep: also choose the configuration inside each fold from its training clips alone and score it on the "
                "held-out fold (the unbiased figure for the sweep's winner; about folds x the sweep's time)")
@@ -686,6 +711,8 @@ void add_gesture_command(CLI::App& app, GlobalOptions&, Action& run) {
   cv->add_option("--sweep-mixtures", o->sweep_mixtures, "mixtures to try (default 1 2 3)")->check(CLI::Range(1, 20));
   cv->add_option("--sweep-covariance", o->sweep_covariance, "covariances to try (default full diag)")
       ->check(CLI::IsMember({"full", "diag"}));
+  cv->add_option("--sweep-init", o->sweep_init, "initialisations to try (default: --init's)")
+      ->check(CLI::IsMember({"segments", "kmeans"}));
   cv->callback([o, &run] { run = [o] { return gesture_cv(*o); }; });
 
   auto* f = g->add_subcommand("features", "Print the per-frame features of recordings as CSV (what the models see)");

@@ -429,6 +429,22 @@ Hmm Hmm::train(const std::vector<Sequence>& data, const TrainOptions& o, TrainRe
     if (!data[s].allFinite()) throw ModelError("training: sequence " + std::to_string(s) + " has NaN or infinite values");
     frames += static_cast<std::size_t>(data[s].rows());
   }
+  if (o.restarts > 1) {
+    Hmm best;
+    TrainReport best_report;
+    double best_ll = kNegInf;
+    for (int r = 0; r < o.restarts; ++r) {
+      TrainOptions one = o;
+      one.restarts = 1;
+      one.seed = o.seed + 0x9E3779B97F4A7C15ULL * static_cast<std::uint64_t>(r);
+      TrainReport rep;
+      Hmm h = train(data, one, &rep);
+      const double ll = rep.log_likelihood.empty() ? kNegInf : rep.log_likelihood.back();
+      if (r == 0 || ll > best_ll) best = std::move(h), best_report = rep, best_ll = ll;
+    }
+    if (report) *report = best_report;
+    return best;
+  }
   const int N = o.states, M = o.mixtures;
   // Regularisation scaled to each feature's spread over all data.
   VectorXd mean = VectorXd::Zero(D), var = VectorXd::Zero(D);
@@ -443,9 +459,18 @@ Hmm Hmm::train(const std::vector<Sequence>& data, const TrainOptions& o, TrainRe
   // j-th part of every sequence; k-means within a state for its mixtures.
   std::mt19937_64 rng(o.seed);
   std::vector<std::vector<VectorXd>> by_state(static_cast<std::size_t>(N));
-  for (const auto& x : data) {
-    for (Eigen::Index t = 0; t < x.rows(); ++t) {
-      by_state[static_cast<std::size_t>(t * N / x.rows())].push_back(x.row(t).transpose());
+  if (o.init == Init::KMeans) {
+    std::vector<VectorXd> all;
+    all.reserve(frames);
+    for (const auto& x : data)
+      for (Eigen::Index t = 0; t < x.rows(); ++t) all.push_back(x.row(t).transpose());
+    const auto label = kmeans(all, N, rng);
+    for (std::size_t i = 0; i < all.size(); ++i) by_state[static_cast<std::size_t>(label[i])].push_back(std::move(all[i]));
+  } else {
+    for (const auto& x : data) {
+      for (Eigen::Index t = 0; t < x.rows(); ++t) {
+        by_state[static_cast<std::size_t>(t * N / x.rows())].push_back(x.row(t).transpose());
+      }
     }
   }
   std::vector<GaussianMixture> em(static_cast<std::size_t>(N));
@@ -488,6 +513,9 @@ Hmm Hmm::train(const std::vector<Sequence>& data, const TrainOptions& o, TrainRe
       if (i + 1 < N) trans(i, i) = 0.6, trans(i, i + 1) = 0.4;
       else trans(i, i) = 1.0;
     }
+  } else if (o.init == Init::KMeans) {
+    start.setConstant(1.0 / N);
+    trans.setConstant(1.0 / N);
   } else {
     start.setConstant(N > 1 ? 0.3 / (N - 1) : 1.0);
     start(0) = N > 1 ? 0.7 : 1.0;

@@ -26,6 +26,13 @@ class ModelError : public std::runtime_error {
 
 enum class Covariance { Full, Diagonal };
 
+// How training picks its first parameters. Segments: each sequence cut into N
+// equal parts, state j from the j-th part of every sequence (suits gestures,
+// which pass through their phases in order). KMeans: k-means++ over all frames
+// pooled, a state per cluster, uniform start and transitions (pomegranate's
+// from_samples; depends more on the seed).
+enum class Init { Segments, KMeans };
+
 struct GaussianMixture {
   Eigen::VectorXd weights;               // M, sum 1
   std::vector<Eigen::VectorXd> means;    // M x D
@@ -48,6 +55,8 @@ struct TrainOptions {
   int mixtures = 1;
   Covariance covariance = Covariance::Full;
   bool left_right = false;      // transitions only to the same or the next state
+  Init init = Init::Segments;
+  int restarts = 1;             // train this many times from different seeds, keep the highest training likelihood
   int max_iterations = 100;
   double tolerance = 1e-4;      // stop when the mean log-likelihood per frame improves less than this
   double regularisation = 1e-3;  // added to covariance diagonals, times each dimension's variance over all data
