@@ -174,9 +174,15 @@ nlohmann::json calibrate_one(const std::string& path, const SkelOptions& o, skel
   }
   j["per_joint"] = per;
   if (o.holdout) {
-    const double b = calib::median(calib::joint_distances(test_ref, test_oth, before, 0, {}, 2.0));
-    const double a = calib::median(calib::joint_distances(test_ref, test_oth, chosen, chosen_offset, {}, 2.0));
+    using skeleton::JointId;
+    static const std::vector<JointId> upper{JointId::Head,         JointId::Neck,      JointId::Torso,
+                                            JointId::LeftShoulder, JointId::RightShoulder, JointId::LeftElbow,
+                                            JointId::RightElbow,   JointId::LeftHand,  JointId::RightHand};
+    const double b = calib::median(calib::joint_distances(test_ref, test_oth, before, 0, upper, 2.0));
+    const double a = calib::median(calib::joint_distances(test_ref, test_oth, chosen, chosen_offset, upper, 2.0));
     j["held_out_median_distance_cm"] = {{"before", num(cm(b))}, {"after", num(cm(a))}};
+    auto& names = j["held_out_joints"] = nlohmann::json::array();
+    for (auto jid : upper) names.push_back(skeleton::joint_name(jid));
   }
   j["verdict"] = improved ? "calibrated: the fitted pose brings the sensors' skeletons closer than before"
                           : "kept the previous pose: the fit did not bring the skeletons closer on the data it saw";
