@@ -228,6 +228,38 @@ TEST(Spotting, AHangingArmIsNoPointing) {
   EXPECT_EQ(spot(c, arm_stream(gesture(2.0, 25), 8), any_angle).size(), 1u);
 }
 
+// With a garbage class, the garbage model is the spotter's "no gesture": a
+// pointing its model wins goes out even below the rejection threshold;
+// without one, the threshold decides.
+TEST(Spotting, TheGarbageClassNotTheThresholdRejects) {
+  std::vector<Clip> clips;
+  for (int i = 0; i < 4; ++i) {
+    Clip point, other;
+    point.label = 0;
+    point.x = Sequence::Random(30, 8);
+    other.label = 1;  // far from any arm's features: the point model always wins
+    other.x = Sequence::Constant(30, 8, 100.0) + 0.01 * Sequence::Random(30, 8);
+    clips.push_back(point);
+    clips.push_back(other);
+  }
+  ClassMap map;
+  map.classes = {"point", "other"};
+  map.garbage = "other";
+  ClassifierOptions o;
+  o.hmm.states = 1;
+  o.hmm.covariance = Covariance::Diagonal;
+  o.trimmed = false;
+  o.calibration_folds = 0;
+  Classifier with_garbage = Classifier::train(clips, map, o);
+  with_garbage.set_threshold(1e300);  // every decision is below it
+  const auto stream = arm_stream(gesture(2.0, 70), 8);
+  ASSERT_EQ(spot(with_garbage, stream).size(), 1u);
+  auto no_garbage = always_point();
+  EXPECT_EQ(spot(no_garbage, stream).size(), 1u);
+  no_garbage.set_threshold(1e300);
+  EXPECT_TRUE(spot(no_garbage, stream).empty());
+}
+
 TEST(Spotting, APersonLostAndFoundSettlesAgain) {
   const auto c = always_point();
   const SpotterOptions o;

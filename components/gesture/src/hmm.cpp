@@ -420,7 +420,7 @@ MatrixXd shape(const MatrixXd& cov, Covariance c, const VectorXd& reg) {
 
 Hmm Hmm::train(const std::vector<Sequence>& data, const TrainOptions& o, TrainReport* report) {
   if (data.empty()) throw ModelError("training: no sequences");
-  if (o.states < 1 || o.mixtures < 1) throw ModelError("training: states and mixtures must be >= 1");
+  if (o.states < 1 || o.mixtures < 1 || o.restarts < 1) throw ModelError("training: states, mixtures and restarts must be >= 1");
   const auto D = data.front().cols();
   std::size_t frames = 0;
   for (std::size_t s = 0; s < data.size(); ++s) {
@@ -455,8 +455,9 @@ Hmm Hmm::train(const std::vector<Sequence>& data, const TrainOptions& o, TrainRe
   const VectorXd reg = o.regularisation * var.cwiseMax(1e-12);
   const MatrixXd global_cov = MatrixXd(var.cwiseMax(1e-12).asDiagonal());
 
-  // Initialisation: each sequence cut into N equal parts, state j taking the
-  // j-th part of every sequence; k-means within a state for its mixtures.
+  // Initialisation (Init::Segments): each sequence cut into N equal parts,
+  // state j taking the j-th part of every sequence; (Init::KMeans) a state
+  // per k-means cluster of all frames. Then k-means within a state for its mixtures.
   std::mt19937_64 rng(o.seed);
   std::vector<std::vector<VectorXd>> by_state(static_cast<std::size_t>(N));
   if (o.init == Init::KMeans) {

@@ -302,7 +302,11 @@ std::optional<SpottedEvent> Spotter::decide(std::int64_t now_ns, bool early) {
   for (std::size_t i = 0; i < segment_.size(); ++i) x.row(static_cast<Eigen::Index>(i)) = segment_[i].x.transpose();
   const Decision d = c_.classify(x);
   const std::string& label = c_.labels()[static_cast<std::size_t>(d.label)];
-  if (d.rejected || d.label == c_.garbage_index()) return std::nullopt;
+  // "No gesture" is the garbage class where the classifier has one; the
+  // rejection threshold only where it has none. Both at once would turn away
+  // a gesture its own model wins, merely for being unlike the training clips
+  // (a jittery hand: Kinder-Gator subject 734's pointing).
+  if (d.label == c_.garbage_index() || (d.rejected && c_.garbage_index() < 0)) return std::nullopt;
   const bool point = label == o_.point_label;
   if (early && !point) return std::nullopt;
   SpottedEvent e;

@@ -22,7 +22,8 @@
 // the shoulder -> hand ray averaged over the hold (the trackers' errors
 // wander over about a second, so a longer look halves the target error of a
 // quarter-second one). Any other segment is classified when it
-// closes; an event goes out when its class is neither garbage nor rejected,
+// closes; an event goes out when its class is not garbage (or, for a
+// classifier without a garbage class, not below the rejection threshold),
 // and for pointing only when an extended arm was held in the segment.
 
 #include <cstdint>
