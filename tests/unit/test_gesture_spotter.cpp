@@ -139,6 +139,16 @@ namespace {
 // A classifier with "point" as its only class that never rejects: every
 // segment the spotter tries is pointing, so the tests below see exactly
 // when the spotter tries (the classifier is not what they are about).
+// One-state diagonal models on the clips as they are (no trimming, no inner folds).
+Classifier one_state(const std::vector<Clip>& clips, const ClassMap& map) {
+  ClassifierOptions o;
+  o.hmm.states = 1;
+  o.hmm.covariance = Covariance::Diagonal;
+  o.trimmed = false;
+  o.calibration_folds = 0;
+  return Classifier::train(clips, map, o);
+}
+
 Classifier always_point() {
   std::vector<Clip> clips;
   for (int i = 0; i < 4; ++i) {
@@ -149,12 +159,7 @@ Classifier always_point() {
   }
   ClassMap map;
   map.classes = {"point"};
-  ClassifierOptions o;
-  o.hmm.states = 1;
-  o.hmm.covariance = Covariance::Diagonal;
-  o.trimmed = false;
-  o.calibration_folds = 0;
-  Classifier c = Classifier::train(clips, map, o);
+  Classifier c = one_state(clips, map);
   c.set_threshold(-1e300);
   return c;
 }
@@ -245,12 +250,7 @@ TEST(Spotting, TheGarbageClassNotTheThresholdRejects) {
   ClassMap map;
   map.classes = {"point", "other"};
   map.garbage = "other";
-  ClassifierOptions o;
-  o.hmm.states = 1;
-  o.hmm.covariance = Covariance::Diagonal;
-  o.trimmed = false;
-  o.calibration_folds = 0;
-  Classifier with_garbage = Classifier::train(clips, map, o);
+  Classifier with_garbage = one_state(clips, map);
   with_garbage.set_threshold(1e300);  // every decision is below it
   const auto stream = arm_stream(gesture(2.0, 70), 8);
   ASSERT_EQ(spot(with_garbage, stream).size(), 1u);
