@@ -136,9 +136,6 @@ TEST(Spotting, FindsPointingInHeldOutSimulatedSessions) {
 
 namespace {
 
-// A classifier with "point" as its only class that never rejects: every
-// segment the spotter tries is pointing, so the tests below see exactly
-// when the spotter tries (the classifier is not what they are about).
 // One-state diagonal models on the clips as they are (no trimming, no inner folds).
 Classifier one_state(const std::vector<Clip>& clips, const ClassMap& map) {
   ClassifierOptions o;
@@ -148,6 +145,10 @@ Classifier one_state(const std::vector<Clip>& clips, const ClassMap& map) {
   o.calibration_folds = 0;
   return Classifier::train(clips, map, o);
 }
+
+// A classifier with "point" as its only class that never rejects: every
+// segment the spotter tries is pointing, so the tests below see exactly
+// when the spotter tries (the classifier is not what they are about).
 
 Classifier always_point() {
   std::vector<Clip> clips;
@@ -258,6 +259,11 @@ TEST(Spotting, TheGarbageClassNotTheThresholdRejects) {
   EXPECT_EQ(spot(no_garbage, stream).size(), 1u);
   no_garbage.set_threshold(1e300);
   EXPECT_TRUE(spot(no_garbage, stream).empty());
+  // The garbage model winning is still no event, whatever the threshold.
+  for (auto& c : clips) c.label = 1 - c.label;  // now the point model is the far one
+  Classifier garbage_wins = one_state(clips, map);
+  garbage_wins.set_threshold(-1e300);
+  EXPECT_TRUE(spot(garbage_wins, stream).empty());
 }
 
 TEST(Spotting, APersonLostAndFoundSettlesAgain) {

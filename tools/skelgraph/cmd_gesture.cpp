@@ -654,7 +654,8 @@ void add_model_options(CLI::App* c, GestureOptions& o) {
       ->check(CLI::IsMember({"canonical", "augment", "as-is"}));
   c->add_flag("--prefixes", o.prefixes, "also train on each clip's first 50 % and 70 % (for spotting, which decides early)");
   c->add_flag("--per-class", o.per_class, "one model per class (the thesis) instead of one per recorded action");
-  c->add_option("--reject-quantile", o.reject_quantile, "share of held-out training clips the rejection threshold may reject (default 0.02)")
+  c->add_option("--reject-quantile", o.reject_quantile, "share of held-out training clips the rejection threshold may reject (default 0.02; spotting with a garbage class leaves "
+                "'no gesture' to it and ignores the threshold)")
       ->check(CLI::Range(0.0, 1.0));
   c->add_option("--iterations", o.iterations, "Baum-Welch iteration cap (default 100)")->check(CLI::Range(1, 10000));
   c->add_option("--init", o.init,

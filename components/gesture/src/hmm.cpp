@@ -421,6 +421,8 @@ MatrixXd shape(const MatrixXd& cov, Covariance c, const VectorXd& reg) {
 Hmm Hmm::train(const std::vector<Sequence>& data, const TrainOptions& o, TrainReport* report) {
   if (data.empty()) throw ModelError("training: no sequences");
   if (o.states < 1 || o.mixtures < 1 || o.restarts < 1) throw ModelError("training: states, mixtures and restarts must be >= 1");
+  if (o.left_right && o.init == Init::KMeans)
+    throw ModelError("training: a left-right model needs the segments initialisation (k-means clusters come in no order)");
   const auto D = data.front().cols();
   std::size_t frames = 0;
   for (std::size_t s = 0; s < data.size(); ++s) {
@@ -477,7 +479,7 @@ Hmm Hmm::train(const std::vector<Sequence>& data, const TrainOptions& o, TrainRe
   std::vector<GaussianMixture> em(static_cast<std::size_t>(N));
   for (int j = 0; j < N; ++j) {
     auto& pts = by_state[static_cast<std::size_t>(j)];
-    if (pts.empty()) pts.push_back(mean);  // more states than frames in every sequence
+    if (pts.empty()) pts.push_back(mean);  // more states than frames in every sequence, or an empty k-means cluster
     const auto label = kmeans(pts, M, rng);
     auto& g = em[static_cast<std::size_t>(j)];
     g.weights = VectorXd::Zero(M);

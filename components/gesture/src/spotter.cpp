@@ -306,6 +306,8 @@ std::optional<SpottedEvent> Spotter::decide(std::int64_t now_ns, bool early) {
   // rejection threshold only where it has none. Both at once would turn away
   // a gesture its own model wins, merely for being unlike the training clips
   // (a jittery hand: Kinder-Gator subject 734's pointing).
+  // A segment no model can explain at all (every score -inf) is never an event.
+  if (!std::isfinite(d.scores[static_cast<std::size_t>(d.label)])) return std::nullopt;
   if (d.label == c_.garbage_index() || (d.rejected && c_.garbage_index() < 0)) return std::nullopt;
   const bool point = label == o_.point_label;
   if (early && !point) return std::nullopt;
