@@ -17,6 +17,7 @@
 #include "skelgraph/calib/board.hpp"
 #include "skelgraph/calib/calib_file.hpp"
 #include "skelgraph/calib/skeleton_calib.hpp"
+#include "skelgraph/eval/metrics.hpp"
 #include "skelgraph/mcap/mcap.hpp"
 #include "skelgraph/msg/cdr.hpp"
 #include "skelgraph/playback/readers.hpp"
@@ -174,10 +175,11 @@ nlohmann::json calibrate_one(const std::string& path, const SkelOptions& o, skel
   }
   j["per_joint"] = per;
   if (o.holdout) {
-    using skeleton::JointId;
-    static const std::vector<JointId> upper{JointId::Head,         JointId::Neck,      JointId::Torso,
-                                            JointId::LeftShoulder, JointId::RightShoulder, JointId::LeftElbow,
-                                            JointId::RightElbow,   JointId::LeftHand,  JointId::RightHand};
+    // The upper body as evaluation scores it, group by group (head, neck, torso, shoulders, elbows, hands).
+    std::vector<skeleton::JointId> upper;
+    for (int g = 0; g < static_cast<int>(eval::kGroupCount); ++g)
+      for (std::size_t k = 0; k < skeleton::kJointCount; ++k)
+        if (eval::group_of(skeleton::joint_at(k)) == g) upper.push_back(skeleton::joint_at(k));
     const double b = calib::median(calib::joint_distances(test_ref, test_oth, before, 0, upper, 2.0));
     const double a = calib::median(calib::joint_distances(test_ref, test_oth, chosen, chosen_offset, upper, 2.0));
     j["held_out_median_distance_cm"] = {{"before", num(cm(b))}, {"after", num(cm(a))}};
