@@ -4,10 +4,31 @@
 # clear error.
 source "$(dirname "$0")/lib.sh"
 
-"$SKELGRAPH" eval sim --scenarios 360,arms --json --report "$WORK/report" >"$WORK/eval.json"
-python3 - "$WORK/eval.json" "$WORK/report" <<'PY' || fail "eval sim: $(head -c 2000 "$WORK/eval.json")"
-import json, sys, os, xml.etree.ElementTree as ET
+"$SKELGRAPH" eval sim --scenarios 360,arms --json --report "$WORK/report" --csv "$WORK/eval.csv" >"$WORK/eval.json"
+"$SKELGRAPH" eval sim --scenarios 360,arms >"$WORK/eval.md" 2>/dev/null
+python3 - "$WORK/eval.json" "$WORK/report" "$WORK/eval.csv" "$WORK/eval.md" <<'PY' || fail "eval sim: $(head -c 2000 "$WORK/eval.json")"
+import csv, json, sys, os, xml.etree.ElementTree as ET
 d, rep = json.load(open(sys.argv[1])), sys.argv[2]
+# The CSV (--csv, and the report's results.csv and per-scenario files) and the
+# Markdown tables carry the same figures as the JSON.
+rows = list(csv.DictReader(open(sys.argv[3])))
+assert open(sys.argv[3]).read() == open(os.path.join(rep, "results.csv")).read()
+assert len(rows) == sum(len(x["streams"]) for x in d["scenarios"]), len(rows)
+md = open(sys.argv[4]).read()
+for x in d["scenarios"]:
+    per = list(csv.DictReader(open(os.path.join(rep, x["scenario"] + ".csv"))))
+    assert per == [r for r in rows if r["scenario"] == x["scenario"]], x["scenario"]
+    section = md.split("### " + x["scenario"] + " (")[1].split("###")[0]
+    for st in x["streams"]:
+        r = next(r for r in per if r["stream"] == st["stream"])
+        assert r["fused"] == ("1" if st["fused"] else "0"), r
+        assert abs(float(r["mean_error_cm"]) - st["mean_error_cm"]) < 1e-3, (r, st["mean_error_cm"])
+        g = st["groups"]["Hands"]
+        assert abs(float(r["Hands_detection_pct"]) - g["detection_pct"]) < 0.01, r
+        assert abs(float(r["bone_length_sd_cm"]) - st["bone_length_sd_cm"]) < 1e-3, r
+        line = next(l for l in section.splitlines() if l.startswith("| %s |" % st["stream"]))
+        cells = [c.strip() for c in line.strip("|").split("|")]
+        assert len(cells) == 17 and abs(float(cells[13]) - st["mean_error_cm"]) <= 0.051, (line, st["mean_error_cm"])
 sc = {x["scenario"]: {s["stream"]: s for s in x["streams"]} for x in d["scenarios"]}
 s = sc["360"]
 det = lambda k, g: s[k]["groups"][g]["detection_pct"]
@@ -17,9 +38,12 @@ for m in ("avg", "sum"):
 best = min(s["sensor1"]["mean_error_cm"], s["sensor2"]["mean_error_cm"])
 assert s["kalman"]["mean_error_cm"] < 0.75 * best, (s["kalman"]["mean_error_cm"], best)
 html = open(os.path.join(rep, "report.html")).read()
-assert html.count("<svg") == 10 and "<table>" in html, html.count("<svg")   # 5 figures per scenario
+# 16 figures per scenario: mean error, each group's error (6), right hand x/y/z,
+# each group's detection timeline (6)
+assert html.count("<svg") == 32 and "<table>" in html, html.count("<svg")
 svgs = [f for f in os.listdir(rep) if f.endswith(".svg")]
-assert len(svgs) == 10, svgs
+assert len(svgs) == 32, svgs
+assert os.path.exists(os.path.join(rep, "360_error_shoulders.svg")) and os.path.exists(os.path.join(rep, "arms_torso_detected.svg"))
 for f in svgs:
     root = ET.parse(os.path.join(rep, f)).getroot()   # well-formed
     assert root.tag.endswith("svg")

@@ -73,6 +73,42 @@ void print_table(const std::string& title, const eval::OfflineResult& r) {
   }
 }
 
+// The tables as CSV (RFC 4180): one row per (scenario or recording, stream),
+// the Markdown table's columns; an empty field where a figure has no value.
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
+  std::string q = "\"";
+  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
+std::string csv_num(double v, int decimals) {
+  if (!std::isfinite(v)) return "";
+  char b[32];
+  std::snprintf(b, sizeof b, "%.*f", decimals, v);
+  return b;
+}
+std::string csv_header() {
+  std::string h = "scenario,stream,fused";
+  for (const auto* g : eval::group_names()) h += std::string(",") + g + "_detection_pct," + g + "_error_cm";
+  return h + ",mean_error_cm,offsets_removed_error_cm,upper_body_complete_pct,bone_length_sd_cm,ticks\n";
+}
+std::string csv_rows(const std::string& scenario, const eval::OfflineResult& r) {
+  std::string out;
+  for (const auto& s : r.streams) {
+    out += csv_field(scenario) + "," + csv_field(s.name) + "," + (s.fused ? "1" : "0");
+    for (const auto& g : s.accuracy.figures()) out += "," + csv_num(g.detection_pct, 2) + "," + csv_num(g.error_cm, 3);
+    out += "," + csv_num(s.accuracy.mean_error_cm(), 3) + "," + csv_num(s.compensated.mean_error_cm(), 3) + "," +
+           csv_num(s.steadiness.upper_body_complete_pct(), 2) + "," + csv_num(s.steadiness.mean_bone_sd_cm(), 3) + "," +
+           std::to_string(s.ticks) + "\n";
+  }
+  return out;
+}
+void write_text_file(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream out(path);
+  out << text;
+  if (!out.flush()) throw std::runtime_error("cannot write " + path.string());
+}
+
 // One scenario's part of the HTML report: its table, error over time, the
 // traced joint's coordinates against truth, and when the hands were tracked.
 // Every figure is also written as its own SVG file next to the report.
@@ -95,6 +131,9 @@ std::string report_section(const std::string& dir, const std::string& name, cons
     h << b;
   }
   h << "</table>\n";
+  write_text_file(std::filesystem::path(dir) / (name + ".csv"), csv_header() + csv_rows(name, r));
+  h << "<p>This table as CSV: <a href=\"" << report::html_escape(name) << ".csv\">" << report::html_escape(name)
+    << ".csv</a></p>\n";
   if (r.streams.empty() || r.streams.front().trace.empty()) return h.str();
   const double t0 = static_cast<double>(r.streams.front().trace.front().t_ns);
   const auto secs = [&](const eval::StreamScore& s) {
@@ -108,20 +147,42 @@ std::string report_section(const std::string& dir, const std::string& name, cons
     if (!out.flush()) throw std::runtime_error("cannot write " + (std::filesystem::path(dir) / file).string());
     h << "<figure>" << svg << "<figcaption>" << report::html_escape(file) << "</figcaption></figure>\n";
   };
-  std::vector<report::Series> err;
-  for (const auto& s : r.streams) {
-    report::Series se{s.name, secs(s), {}};
-    for (const auto& p : s.trace) {
-      double sum = 0;
-      int n = 0;
-      for (double e : p.error_cm) {
-        if (std::isfinite(e)) sum += e, ++n;
+  // Error over time: the upper body's mean per tick, then each joint group's (the thesis's Fig. 5.2).
+  const auto error_series = [&](int group) {  // group -1: the mean over the groups reported at the tick
+    std::vector<report::Series> err;
+    for (const auto& s : r.streams) {
+      report::Series se{s.name, secs(s), {}};
+      for (const auto& p : s.trace) {
+        if (group >= 0) {
+          se.y.push_back(p.error_cm[static_cast<std::size_t>(group)]);
+          continue;
+        }
+        double sum = 0;
+        int n = 0;
+        for (double e : p.error_cm) {
+          if (std::isfinite(e)) sum += e, ++n;
+        }
+        se.y.push_back(n > 0 ? sum / n : std::nan(""));
       }
-      se.y.push_back(n > 0 ? sum / n : std::nan(""));
+      err.push_back(std::move(se));
     }
-    err.push_back(std::move(se));
+    return err;
+  };
+  write(name + "_error.svg",
+        report::line_plot(title + ": mean upper-body error per tick", "time (s)", "error (cm)", error_series(-1)));
+  const auto group_file = [](const char* group) {
+    std::string g = group;
+    std::transform(g.begin(), g.end(), g.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    return g;
+  };
+  h << "<details><summary>Error over time per joint group</summary>\n";
+  for (std::size_t g = 0; g < eval::kGroupCount; ++g) {
+    const char* group = eval::group_names()[g];
+    write(name + "_error_" + group_file(group) + ".svg",
+          report::line_plot(title + ": " + group + " error per tick", "time (s)", "error (cm)",
+                            error_series(static_cast<int>(g)), 760, 220));
   }
-  write(name + "_error.svg", report::line_plot(title + ": mean upper-body error per tick", "time (s)", "error (cm)", err));
+  h << "</details>\n";
   // The traced joint against truth, per coordinate (the thesis's Fig. 5.3/5.4).
   const eval::StreamScore* kalman = nullptr;
   for (const auto& s : r.streams) {
@@ -144,13 +205,25 @@ std::string report_section(const std::string& dir, const std::string& name, cons
     write(name + "_" + joint + "_" + c + ".svg",
           report::line_plot(title + ": " + joint + " " + c + " (world)", "time (s)", c + " (m)", xyz, 760, 220));
   }
-  std::vector<report::Strip> strips;
-  for (const auto& s : r.streams) {
-    report::Strip st{s.name, secs(s), {}};
-    for (const auto& p : s.trace) st.on.push_back(std::isfinite(p.error_cm[5]));
-    strips.push_back(std::move(st));
+  // Detection timelines: when each group was reported at confidence 1, hands first (what fusion gains most).
+  const auto strips_of = [&](std::size_t group) {
+    std::vector<report::Strip> strips;
+    for (const auto& s : r.streams) {
+      report::Strip st{s.name, secs(s), {}};
+      for (const auto& p : s.trace) st.on.push_back(std::isfinite(p.error_cm[group]));
+      strips.push_back(std::move(st));
+    }
+    return strips;
+  };
+  constexpr std::size_t kHands = eval::kGroupCount - 1;
+  write(name + "_hands_detected.svg", report::timeline(title + ": hands reported at confidence 1", strips_of(kHands)));
+  h << "<details><summary>Detection timelines of the other joint groups</summary>\n";
+  for (std::size_t g = 0; g < kHands; ++g) {
+    const char* group = eval::group_names()[g];
+    write(name + "_" + group_file(group) + "_detected.svg",
+          report::timeline(title + ": " + group + " reported at confidence 1", strips_of(g)));
   }
-  write(name + "_hands_detected.svg", report::timeline(title + ": hands reported at confidence 1", strips));
+  h << "</details>\n";
   return h.str();
 }
 
@@ -298,7 +371,7 @@ void stream_recording(const RecordingInputs& in, eval::Evaluator& ev, const Mess
 }
 
 struct FileOptions {
-  std::string file, out, report_dir;
+  std::string file, out, report_dir, csv;
   std::vector<std::string> methods;
   double delay_ms = 0, max_age_ms = 100;
   bool json = false, shared_frame = false;
@@ -363,6 +436,7 @@ int eval_file(const FileOptions& o) {
   }
   nlohmann::json j = scored.summary;
   if (!report_path.empty()) j["report"] = report_path;
+  if (!o.csv.empty()) write_text_file(o.csv, csv_header() + csv_rows(o.file, r));
   if (o.json) {
     std::printf("%s\n", j.dump(2).c_str());
   } else {
@@ -476,6 +550,7 @@ int eval_sim(const SimEvalOptions& o) {
   std::string html;
   if (eo.trace) std::filesystem::create_directories(o.report_dir);
   nlohmann::json out = nlohmann::json::array();
+  std::string csv = csv_header();
   if (!o.json && !o.quiet) {
     std::printf("## Fusion against ground truth (simulator)\n\nDetection: %% of output ticks (30 Hz) a joint is reported "
                 "with confidence 1; error: mean distance to truth over those, cm. Singles: each sensor alone, on the same "
@@ -563,7 +638,10 @@ int eval_sim(const SimEvalOptions& o) {
     }
     if (!o.json && !o.quiet) print_table(title, r);
     if (eo.trace) html += report_section(o.report_dir, scenario, title, r, "right_hand");
+    csv += csv_rows(scenario, r);
   }
+  if (!o.csv.empty()) write_text_file(o.csv, csv);
+  if (eo.trace) write_text_file(std::filesystem::path(o.report_dir) / "results.csv", csv);
   if (eo.trace) {
     const auto path = write_report_page(o.report_dir, "skelgraph: fusion against ground truth",
                                         o.extra_html + html);
@@ -622,7 +700,10 @@ void add_eval_command(CLI::App& app, GlobalOptions&, Action& run) {
   s->add_option("--depth-size", o->depth_size, "depth: image size (160x120, 320x240, 640x480)");
   s->add_option("--girth", o->girth, "depth: the simulated people's build (1: the renderer's standard; 0.85 slim, 1.25 stout)")
       ->check(CLI::Range(0.5, 2.0));
-  s->add_option("--report", o->report_dir, "also write DIR/report.html (tables, inline SVG plots) and each plot as SVG");
+  s->add_option("--report", o->report_dir,
+                "also write DIR/report.html (tables, inline SVG plots), each plot as SVG, each table as CSV "
+                "(DIR/<scenario>.csv, all of them in DIR/results.csv)");
+  s->add_option("--csv", o->csv, "also write the tables as CSV to this file (a row per scenario and stream)");
   s->callback([o, &run] { run = [o] { return eval_sim(*o); }; });
 
   auto fo = std::make_shared<FileOptions>();
@@ -635,7 +716,9 @@ void add_eval_command(CLI::App& app, GlobalOptions&, Action& run) {
   r->add_flag("--shared-frame", fo->shared_frame, "the sensors' skeletons are already in one frame (e.g. KinectMultiTrack): no poses needed");
   r->add_option("--calibration", fo->calibration, "sensor poses from this calibration file (YAML) instead of the recording's")
       ->check(CLI::ExistingFile);
-  r->add_option("--report", fo->report_dir, "also write DIR/report.html (table, inline SVG plots) and each plot as SVG");
+  r->add_option("--report", fo->report_dir,
+                "also write DIR/report.html (table, inline SVG plots), each plot as SVG and the table as CSV");
+  r->add_option("--csv", fo->csv, "also write the table as CSV to this file (a row per stream)");
   r->callback([fo, &run] { run = [fo] { return eval_file(*fo); }; });
 }
 

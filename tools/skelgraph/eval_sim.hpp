@@ -20,6 +20,7 @@ struct SimEvalOptions {
   bool json = false;
   bool quiet = false;  // nothing on stdout (progress still on stderr)
   std::string report_dir;
+  std::string csv;         // also write the tables as CSV to this file
   std::string extra_html;  // report sections placed before the scenarios' (the demo's live recording)
 };
 
