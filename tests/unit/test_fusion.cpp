@@ -256,6 +256,53 @@ TEST(Fusion, KalmanStaysStillWhenTwoStillSensorsDisagree) {
   EXPECT_LT(*hi - *lo, 0.01) << "the fused left hand wandered over " << *hi - *lo << " m";
 }
 
+// A person stands at the origin for two seconds, seen by both sensors; then
+// one sensor's skeleton slides 70 cm towards that sensor along its line of
+// sight (its tracker lost the person behind a partition and left a ghost on
+// it) while the other sensor still sees the person where they are. The
+// filter must come back to the person once the two are clearly apart and
+// stay there; the sliding view is the one left out. Sliding towards both
+// sensors instead (into the open, where both would see the person), no
+// occluder explains it: nothing is left out.
+namespace {
+struct GhostRun {
+  double worst_torso_m = 0;  // from the person, from a second after the slide
+  std::uint64_t occluded_views = 0;
+};
+GhostRun run_ghost(int ghost_sensor, const Vector3d& slide) {
+  auto f = make(fusion::Method::Kalman);
+  GhostRun r;
+  for (int k = 0; k < 150; ++k) {
+    const std::int64_t t = k * 33 * kMs;
+    const double a = std::clamp((k - 60) / 30.0, 0.0, 1.0);  // slides from 2 s to 3 s, then stays
+    for (int s = 1; s <= 2; ++s) {
+      const Vector3d at = s == ghost_sensor ? Vector3d(0, 1, 0) + a * slide : Vector3d(0, 1, 0);
+      f.add(in_sensor(person("s" + std::to_string(s), 1, at), s == 1 ? kS1 : kS2), t);
+    }
+    const auto out = f.fuse(t + kMs);
+    if (out.size() != 1u) ADD_FAILURE() << "tick " << k << ": " << out.size() << " people";
+    if (k >= 100 && !out.empty()) {  // from a second after the slide
+      r.worst_torso_m = std::max(r.worst_torso_m, (out[0][JointId::Torso].position - Vector3d(0, 1.2, 0)).norm());
+    }
+  }
+  r.occluded_views = f.stats().occluded_views;
+  return r;
+}
+}  // namespace
+
+TEST(Fusion, KalmanLeavesOutTheSensorThatSeesAnOccluder) {
+  // Sensor 1 is at +z, sensor 2 at +x (both at 1.2 m); towards a sensor = along its line of sight.
+  const auto towards = [](const Vector3d& sensor) { return Vector3d(0.7 * (sensor - Vector3d(0, 1.2, 0)).normalized()); };
+  for (int ghost : {1, 2}) {
+    const auto r = run_ghost(ghost, towards(ghost == 1 ? kS1 : kS2));
+    EXPECT_LT(r.worst_torso_m, 0.06) << "ghost from sensor " << ghost;
+    EXPECT_GT(r.occluded_views, 30u) << "ghost from sensor " << ghost;
+  }
+  // Into the open between the sensors: in front of both, behind neither.
+  EXPECT_EQ(run_ghost(1, Vector3d(0.5, 0, 0.5)).occluded_views, 0u);
+  EXPECT_EQ(run_ghost(2, Vector3d(0.5, 0, 0.5)).occluded_views, 0u);
+}
+
 TEST(JointFilter, ConvergesOnAMovingPointAndEstimatesItsVelocity) {
   fusion::JointFilter kf;
   kf.reset({0, 0, 0}, 0.05, 0);

@@ -516,7 +516,8 @@ int fuse_file(const FileOptions& o) {
   for (std::size_t i = 0; i < r.streams.size(); ++i) {
     per[r.streams[i].name] = {{"ticks_with_output", r.streams[i].with_output},
                               {"flips_corrected", r.fuser_stats[i].flips_corrected},
-                              {"gated", r.fuser_stats[i].gated}};
+                              {"gated", r.fuser_stats[i].gated},
+                              {"occluded_views", r.fuser_stats[i].occluded_views}};
   }
   if (o.json) {
     std::printf("%s\n", nlohmann::json{{"in", o.file}, {"out", o.out}, {"copied", copied}, {"fused", fused_count},

@@ -45,6 +45,7 @@ struct Sample {
 
 struct Stream {
   std::size_t sensor;
+  std::int64_t first_ns = 0;  // its first sample: a tracker's fresh skeleton is still settling
   std::deque<Sample> samples;
   std::optional<std::uint32_t> track;
 };
@@ -64,6 +65,7 @@ struct View {
   double facing = 0;     // cos of the angle between the person's heading and the way to the sensor
   double conf_sum = 0;
   bool flipped = false;
+  bool occluded = false;  // kalman: probably on an occluder in front of the person (see mark_occluded)
 };
 
 struct Bone {
@@ -296,6 +298,37 @@ struct Fuser::Impl {
     return false;
   }
 
+  // Depth sensors cannot see through things: a view whose skeleton is far
+  // from another sensor's, with that other skeleton behind it along this
+  // sensor's line of sight, is explained by this sensor seeing something in
+  // front of the person (a partition, a box: where a tracker that lost the
+  // person leaves its ghost), and the person hidden behind it. The other way
+  // round it is not: the other sensor would be reporting a person where its
+  // own depth image shows free space. Such a view is left out while the two
+  // disagree; with no clear answer (both or neither) nothing is left out, nor
+  // while either stream is under a second old (a tracker that has just found
+  // someone places them tens of centimetres off for a while, either way).
+  void mark_occluded(std::vector<View*>& vs, std::int64_t t) {
+    constexpr double kApart = 0.3;  // m between the skeletons' centres: beyond any tracker noise
+    constexpr std::int64_t kSettledNs = 1'000'000'000;
+    const auto settled = [&](const View& v) { return t - v.stream->first_ns >= kSettledNs; };
+    const auto behind = [&](const View& v, const View& u) {  // u hidden behind v from v's sensor
+      const Vector3d ray = (v.centre - sensor_position(v.sensor)).normalized();
+      const Vector3d o = u.centre - v.centre;
+      const double along = o.dot(ray);
+      return along > 0.5 * kApart && (o - along * ray).norm() < along;  // within 45 degrees of the ray
+    };
+    for (View* v : vs) {
+      for (const View* u : vs) {
+        if (u == v || u->sensor == v->sensor || u->occluded || !settled(*u) || !settled(*v) ||
+            (u->centre - v->centre).norm() < kApart)
+          continue;
+        if (behind(*v, *u) && !behind(*u, *v)) v->occluded = true;
+      }
+    }
+    for (const View* v : vs) stats.occluded_views += v->occluded ? 1 : 0;
+  }
+
   double measurement_sigma(const View& v, std::size_t j) const {
     const auto& jj = v.s.joints[j];
     const double d = (jj.position - sensor_position(v.sensor)).norm();
@@ -305,13 +338,15 @@ struct Fuser::Impl {
     return 0.03 * dist * view * conf;
   }
 
-  void fuse_kalman(Track& tr, const std::vector<View*>& vs, std::int64_t t, skeleton::Skeleton& out) {
+  void fuse_kalman(Track& tr, std::vector<View*>& vs, std::int64_t t, skeleton::Skeleton& out) {
+    mark_occluded(vs, t);
+    const bool arbitrated = std::any_of(vs.begin(), vs.end(), [](const View* v) { return v->occluded; });
     for (std::size_t j = 0; j < kJointCount; ++j) {
       auto& f = tr.filters[j];
       auto& oj = out.joints[j];
       std::vector<std::pair<const View*, double>> meas;
       for (const View* v : vs) {
-        if (v->s.joints[j].confidence >= kInferred) meas.emplace_back(v, measurement_sigma(*v, j));
+        if (!v->occluded && v->s.joints[j].confidence >= kInferred) meas.emplace_back(v, measurement_sigma(*v, j));
       }
       bool tracked = false, any = false;
       // Every sensor's measurement fell outside the gate, but two or more of
@@ -326,7 +361,9 @@ struct Fuser::Impl {
         }
       }
       bool sensors_agree_against_filter = false;
-      if (f.initialised() && meas.size() >= 2 && tr.misses[j] < kResetAfterMisses && agree) {
+      // (or, with an occluded view left out, the filter followed that view: the rest start it over at once)
+      if (f.initialised() && (meas.size() >= 2 || (arbitrated && !meas.empty())) && tr.misses[j] < kResetAfterMisses &&
+          agree) {
         bool all_gated = true;
         for (const auto& [v, sg] : meas) all_gated = all_gated && f.mahalanobis2(v->s.joints[j].position, sg) > kGate;
         sensors_agree_against_filter = all_gated;
@@ -481,6 +518,7 @@ void Fuser::add(const skeleton::Skeleton& raw, std::int64_t t_ns) {
   for (auto& j : s.world.joints) j.position = sensor.pose * j.position;
   s.world.frame_id = "world";
   auto& st = impl_->streams[{i, raw.person_id}];
+  if (st.samples.empty()) st.first_ns = t_ns;
   st.sensor = i;
   // Samples arrive in time order from one sensor; keep a few for interpolation.
   auto pos = std::upper_bound(st.samples.begin(), st.samples.end(), t_ns,

@@ -150,6 +150,7 @@ nlohmann::json FusionComponent::details() const {
           {"samples_without_pose", st.no_pose},
           {"flips_corrected", st.flips_corrected},
           {"gated", st.gated},
+          {"occluded_views", st.occluded_views},
           {"tracks_merged", st.tracks_merged}};
 }
 

@@ -15,7 +15,11 @@
 //  kalman   a constant-velocity filter per joint; measurement noise from
 //           confidence, view angle and distance; Mahalanobis gating; sensors
 //           seeing the person's back (left/right swapped) are detected against
-//           the person's heading and corrected; limb lengths held steady.
+//           the person's heading and corrected; limb lengths held steady;
+//           when two sensors place the person apart, the one whose skeleton
+//           lies in front of the other's along its own line of sight (it sees
+//           an occluder, where a tracker that lost the person leaves its
+//           ghost) is left out.
 
 #include <cstdint>
 #include <map>
@@ -49,6 +53,9 @@ struct FuserOptions {
 struct FuserStats {
   std::uint64_t added = 0, no_pose = 0, fused = 0, flips_corrected = 0, gated = 0;
   std::uint64_t tracks_merged = 0;  // a sensor's stream moved to an older track of the same person
+  // kalman: views left out because they disagreed with another sensor's and
+  // lay in front of it along their own line of sight (on an occluder: a ghost)
+  std::uint64_t occluded_views = 0;
 };
 
 class Fuser {
