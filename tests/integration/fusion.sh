@@ -100,6 +100,7 @@ cam cam2b sensor2 -p publish_truth=false
 cam2b=$!
 status OK || fail "fusion did not take sensor2 back: $(tail -5 "$WORK/fusion.err")"
 after=$(rate back)
+python3 -c "import sys; sys.exit(0 if 27 <= float(sys.argv[1]) <= 33 else 1)" "$after" || fail "fused rate with sensor2 back: $after Hz"
 ok "sensor2 back: OK again, $after Hz"
 
 kill -INT "$fusion" "$cam1" "$cam2b"

@@ -103,6 +103,85 @@ TEST(Fusion, SumTakesTheSensorWithTheHigherConfidenceSum) {
   EXPECT_EQ(out[0][JointId::Head].sensor_mask, 2u);
 }
 
+TEST(Fusion, SumTakesTheOnlyTrackedSensorForAJoint) {
+  // s1's skeleton has the higher confidence sum, but only s2 tracks the left
+  // hand: the thesis's rule takes the one sensor at confidence 1 for that joint.
+  auto f = make(fusion::Method::Sum);
+  auto a = person("s1", 1, {0, 1, 0});
+  auto b = person("s2", 1, {0.04, 1, 0});
+  a[JointId::LeftHand].confidence = 0.5f;
+  b[JointId::LeftFoot].confidence = 0.0f;
+  b[JointId::RightFoot].confidence = 0.0f;
+  f.add(in_sensor(a, kS1), 0);
+  f.add(in_sensor(b, kS2), 0);
+  const auto out = f.fuse(10 * kMs);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0][JointId::LeftHand].sensor_mask, 2u);
+  EXPECT_NEAR(out[0][JointId::LeftHand].position.x(), b[JointId::LeftHand].position.x(), 1e-9);
+  EXPECT_FLOAT_EQ(out[0][JointId::LeftHand].confidence, 1.0f);
+  EXPECT_EQ(out[0][JointId::Head].sensor_mask, 1u);  // elsewhere the higher sum wins
+}
+
+// `weighted` and `kalman` trust a sensor the person faces more than one that
+// sees them side-on, and a tracked joint more than an inferred one. Both
+// sensors see a still person; the side sensor puts the head 4 cm further along x.
+namespace {
+double fused_head_x(fusion::Method m, float side_confidence, float front_confidence = 1.0f) {
+  auto f = make(m);
+  double x = std::nan("");
+  for (int k = 0; k < 30; ++k) {
+    const std::int64_t t = k * 33 * kMs;
+    auto a = person("s1", 1, {0, 1, 0});
+    auto b = person("s2", 1, {0, 1, 0});
+    b[JointId::Head].position.x() += 0.04;
+    a[JointId::Head].confidence = front_confidence;
+    b[JointId::Head].confidence = side_confidence;
+    f.add(in_sensor(a, kS1), t);
+    f.add(in_sensor(b, kS2), t);
+    const auto out = f.fuse(t + kMs);
+    if (out.size() == 1u) x = out[0][JointId::Head].position.x();
+  }
+  return x;
+}
+}  // namespace
+
+TEST(Fusion, WeightedAndKalmanTrustTheFrontViewAndTrackedJointsMore) {
+  for (auto m : {fusion::Method::Weighted, fusion::Method::Kalman}) {
+    const double both = fused_head_x(m, 1.0f);
+    EXPECT_GT(both, 0.002) << fusion::method_name(m);   // both sensors count
+    EXPECT_LT(both, 0.017) << fusion::method_name(m);   // the front one more (an even mean: 0.02)
+    const double side_inferred = fused_head_x(m, 0.5f);
+    EXPECT_LT(side_inferred, 0.6 * both) << fusion::method_name(m);
+    const double front_inferred = fused_head_x(m, 1.0f, 0.5f);
+    EXPECT_GT(front_inferred, 0.023) << fusion::method_name(m);  // now the side one counts more
+  }
+}
+
+TEST(Fusion, KalmanHoldsALimbToTheLengthItLearnt) {
+  // Both sensors agree; the right forearm is 30 cm for the first 11 s (the
+  // length is learnt from a limb's first 300 confident frames), then both
+  // put the hand 10 cm further out along it. The filter pulls the hand half
+  // way back towards the learnt length instead of following the stretched limb.
+  auto f = make(fusion::Method::Kalman);
+  double len = 0;
+  for (int k = 0; k < 370; ++k) {
+    const std::int64_t t = k * 33 * kMs;
+    for (int s = 1; s <= 2; ++s) {
+      auto p = person("s" + std::to_string(s), 1, {0, 1, 0});
+      const Vector3d elbow = p[JointId::RightElbow].position;
+      const Vector3d dir = (p[JointId::RightHand].position - elbow).normalized();
+      p[JointId::RightHand].position = elbow + dir * (k < 330 ? 0.30 : 0.40);
+      f.add(in_sensor(p, s == 1 ? kS1 : kS2), t);
+    }
+    const auto out = f.fuse(t + kMs);
+    ASSERT_EQ(out.size(), 1u);
+    len = (out[0][JointId::RightHand].position - out[0][JointId::RightElbow].position).norm();
+    if (k == 329) EXPECT_NEAR(len, 0.30, 0.005);
+  }
+  EXPECT_GT(len, 0.32);  // it does follow part of the way
+  EXPECT_LT(len, 0.37);  // but not to the 40 cm both sensors report
+}
+
 TEST(Fusion, FacingPrefersTheSensorInFrontOfTheTorso) {
   auto f = make(fusion::Method::Facing);
   // The person faces +z: sensor 1 (at +z) is in front, sensor 2 (at +x) to the side.
