@@ -60,6 +60,20 @@ json_check "$WORK/world.json" 'd["reference"] == "world" and d["views_used"] == 
 compare_pose "$WORK/boards/truth.yaml" "$WORK/world2.yaml" 0.01 0.5 || fail "board-to-world calibration against the truth"
 ok "checkerboard with motion-capture markers: sensor2 in the world within 1 cm and 0.5 degree"
 
+# The wrong board: the square size given wrong puts the board's markers (and
+# so its corners) in the wrong place in the world: a poor verdict and exit 1,
+# not a pose written as if all were well. The wrong corner count finds no board.
+set +e
+"$S" calib board "$WORK/boards/sensor2" --ref sensor2 --world-markers "$WORK/boards/markers.yaml" --board 9x6 --square 0.04 \
+  --out "$WORK/wrong_square.yaml" --json >"$WORK/wrong_square.json" 2>"$WORK/wrong_square.err"; rc4=$?
+"$S" calib intrinsics "$WORK/boards/sensor1/intrinsics/000_color.png" --board 8x6 --square 0.08 >/dev/null 2>"$WORK/bad4.err"; rc5=$?
+set -e
+[ "$rc4" -eq 1 ] || fail "calib board with the wrong --square: rc $rc4 (expected 1), $(cat "$WORK/wrong_square.err")"
+json_check "$WORK/wrong_square.json" 'd["verdict"].startswith("poor:") and "--square" in d["verdict"] and d["rms_residual_cm"] >= 1'
+[ "$rc5" -eq 2 ] && grep -q "the 8x6 board (inner corners, columns x rows) was found in 0 of 1 images.*is --board right" "$WORK/bad4.err" ||
+  fail "calib intrinsics with the wrong --board: rc $rc5, $(cat "$WORK/bad4.err")"
+ok "wrong board: --square 0.04 for 0.08 gives a poor verdict and exit 1; --board 8x6 for 9x6 says so (exit 2)"
+
 # Bad input: a sensor that is not there, a malformed calibration file, missing intrinsics.
 set +e
 "$S" calib board "$WORK/boards/sensor1" "$WORK/exp" >/dev/null 2>"$WORK/bad3.err"; rc3=$?
@@ -80,8 +94,23 @@ ok "bad input: clear errors (unknown sensor; file:line of a malformed calibratio
 # skeleton (recorded live) is scored against the truth in the world frame.
 "$S" bag record --now --label calib --dir "$WORK/rec" >/dev/null 2>"$WORK/rec.err" &
 rec=$!
-"$S" launch bringup/fusion_calibrated.yaml --duration 8 --json >"$WORK/launch.json" 2>"$WORK/launch.err" ||
-  fail "launch fusion_calibrated: $(tail -5 "$WORK/launch.err")"
+"$S" launch bringup/fusion_calibrated.yaml --duration 8 --json >"$WORK/launch.json" 2>"$WORK/launch.err" &
+launch=$!
+# A late joiner gets the poses (reliable, transient-local): read once fusion
+# already publishes, i.e. well after the calibration component sent them.
+"$S" topic echo skelgraph/skeleton/fused --count 1 --timeout 10 >/dev/null 2>"$WORK/late.err" ||
+  fail "no fused skeleton from fusion_calibrated: $(cat "$WORK/late.err")"
+"$S" topic echo skelgraph/calibration --count 2 --timeout 5 --json >"$WORK/late.jsonl" 2>>"$WORK/late.err" ||
+  fail "a late reader of skelgraph/calibration got no poses: $(cat "$WORK/late.err")"
+python3 - "$WORK/late.jsonl" <<'PY' || fail "late reader: $(cat "$WORK/late.jsonl")"
+import json, sys
+poses = [json.loads(l) for l in open(sys.argv[1]) if l.strip()]
+poses = [p["data"] for p in poses]
+assert sorted(p["sensor_id"] for p in poses) == ["sensor1", "sensor2"], poses
+assert all(p["frame_id"] == "world" for p in poses), poses
+PY
+wait "$launch" || fail "launch fusion_calibrated: $(tail -5 "$WORK/launch.err")"
+ok "a reader that joins late gets both sensors' poses from the calibration component"
 kill -INT "$rec"; wait "$rec" || fail "recorder: $(cat "$WORK/rec.err")"
 json_check "$WORK/launch.json" '[c for c in d["components"] if c["name"] == "calibration"][0]["details"]["published"] == 2'
 "$S" eval recording "$WORK"/rec/calib_*.mcap --methods kalman --json >"$WORK/eval.json" 2>"$WORK/eval.err" ||

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # `skelgraph gesture` end to end on the real Kinder-Gator recordings
 # (../shared/data, read in place): train, classify with --json, k-fold
-# cross-validation with an SVG confusion matrix, the features as CSV, and
-# bad input (a class file with an error, a malformed model).
+# cross-validation with an SVG confusion matrix, a small --sweep, the features
+# as CSV, and bad input (a class file with an error, a malformed model).
 source "$(dirname "$0")/lib.sh"
 S=$SKELGRAPH
 KG=${SKELGRAPH_DATA_DIR:-$SKELGRAPH_SOURCE_DIR/../shared/data}/kinder-gator/adults
@@ -53,6 +53,30 @@ json_check "$WORK/cv_km.json" 'd["config"]["init"] == "kmeans" and d["config"]["
 "$S" gesture cv "$WORK/five" --classes five-class --init random 2>"$WORK/bad.err" && fail "--init random was accepted"
 grep -q "init" "$WORK/bad.err" || fail "--init random: $(cat "$WORK/bad.err")"
 ok "five-class with k-means initialisation and restarts; an unknown --init is refused"
+
+# A small sweep (2 states x 2 covariances, 1 mixture; under a second): every configuration is reported, and the
+# winner (config and metrics) is the sweep's best by accuracy, then the first class's F1.
+"$S" gesture cv "$WORK/five" --classes five-class --split kfold --folds 2 --sweep --sweep-states 2 3 --sweep-mixtures 1 \
+  --sweep-covariance diag full --json >"$WORK/sweep.json" 2>"$WORK/sweep.err" || fail "gesture cv --sweep: $(tail -3 "$WORK/sweep.err")"
+python3 - "$WORK/sweep.json" <<'PY' || fail "gesture cv --sweep: $(cat "$WORK/sweep.json")"
+import json, sys
+d = json.load(open(sys.argv[1]))
+first = d["metrics"]["labels"][0]
+f1 = "f1_" + first
+runs = d["sweep"]
+tried = sorted((r["states"], r["mixtures"], r["covariance"]) for r in runs)
+assert tried == [(2, 1, "diag"), (2, 1, "full"), (3, 1, "diag"), (3, 1, "full")], tried
+assert all(r["init"] == "segments" and r["features"] == "thesis8" for r in runs), runs
+win = [r for r in runs if {k: v for k, v in r.items() if k not in ("accuracy", f1)} == d["config"]]
+assert len(win) == 1, (d["config"], runs)
+win = win[0]
+assert win["accuracy"] == d["metrics"]["accuracy"] and win[f1] == d["metrics"]["per_class"][first]["f1"], (win, d["metrics"])
+key = lambda r: (r["accuracy"], r[f1])
+assert key(win) == max(map(key, runs)), (win, runs)
+assert len({key(r) for r in runs}) > 1, runs  # the configurations do differ, so the choice is not vacuous
+assert sum(map(sum, d["metrics"]["confusion"])) == 50, d["metrics"]["confusion"]
+PY
+ok "sweep over 4 configurations: all reported, the winner ($(json_get "$WORK/sweep.json" 'd["config"]["states"]') states, $(json_get "$WORK/sweep.json" 'd["config"]["covariance"]'), accuracy $(json_get "$WORK/sweep.json" 'd["metrics"]["accuracy"]')) is the best"
 
 "$S" gesture features "$KG"/*p565_24-Point* >"$WORK/features.csv" || fail "gesture features"
 head -1 "$WORK/features.csv" | grep -q "right_forearm_angle_speed" || fail "features header: $(head -1 "$WORK/features.csv")"

@@ -10,6 +10,9 @@ cd "$SKELGRAPH_SOURCE_DIR"
 
 "$S" topic echo skelgraph/gesture/event --json --count 2 --timeout 60 >"$WORK/events.json" 2>"$WORK/echo.err" &
 echo_pid=$!
+# Every state the component publishes (on each change and once a second), until the launch ends.
+"$S" topic echo skelgraph/gesture/state --json --timeout 60 >"$WORK/states.json" 2>"$WORK/echo_state.err" &
+state_pid=$!
 "$S" launch bringup/gesture_sim.yaml --duration 35 --json >"$WORK/launch.json" 2>"$WORK/launch.err" \
   || fail "launch: $(tail -5 "$WORK/launch.err")"
 wait "$echo_pid" || fail "topic echo saw no gesture events: $(cat "$WORK/echo.err")"
@@ -28,6 +31,31 @@ for l in lines:
         assert e["target_name"] == "floor" and abs(e["target"]["y"]) < 1e-6, e
 PY
 ok "live: $n pointing events with floor targets, read over DDS too"
+
+kill -TERM "$state_pid" 2>/dev/null || true
+wait "$state_pid" || fail "topic echo saw no gesture states: $(cat "$WORK/echo_state.err")"
+python3 - "$WORK/states.json" "$WORK/events.json" <<'PY' || fail "gesture states over DDS"
+import json, sys
+states = [json.loads(l).get("data") for l in open(sys.argv[1]) if l.strip()]
+events = [json.loads(l).get("data") for l in open(sys.argv[2]) if l.strip()]
+# 35 s: at least one a second while the person is watched, and more on every change.
+assert len(states) >= 20, len(states)
+for s in states:
+    assert s["state"] in ("resting", "moving", "holding"), s
+    assert s["person_id"] >= 1 and s["source"] and s["stamp_ns"] > 0, s
+seen = {s["state"] for s in states}
+assert seen == {"resting", "moving", "holding"}, seen  # arms down between gestures, waves and stretches, pointing
+# Skeleton stamps never go back (one writer, reliable: in order).
+stamps = [s["stamp_ns"] for s in states]
+assert all(a <= b for a, b in zip(stamps, stamps[1:])), stamps
+# Each pointing event read over DDS came with its person holding still during the gesture.
+for e in events:
+    held = [s for s in states if s["person_id"] == e["person_id"] and s["source"] == e["source"] and s["state"] == "holding"
+            and e["start_stamp_ns"] <= s["stamp_ns"] <= e["end_stamp_ns"]]
+    assert held, (e, [(s["stamp_ns"], s["state"]) for s in states])
+print(len(states), "states:", ", ".join(f"{k} {sum(s['state'] == k for s in states)}" for k in ("resting", "moving", "holding")))
+PY
+ok "live: gesture states read over DDS, 'holding' during each pointing event"
 
 "$S" gesture sim --train-sessions 4 --test-sessions 2 --json >"$WORK/sim.json" 2>/dev/null || fail "gesture sim"
 json_check "$WORK/sim.json" 'd["spotting"]["truth"] == 12 and d["spotting"]["recall"] >= 0.8 and d["spotting"]["median_target_error_m"] < 0.4'

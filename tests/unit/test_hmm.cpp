@@ -1,4 +1,5 @@
-// The HMM core: forward and Viterbi against brute force over every path,
+// The HMM core: forward, Viterbi and state posteriors against brute force
+// over every path, covariances kept positive definite on degenerate data,
 // emissions far from the origin against the Gaussians evaluated directly,
 // no underflow on long sequences, streaming equals batch, Baum-Welch raises
 // the likelihood and finds the generating model's states, save/load and
@@ -6,13 +7,16 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
 #include <random>
+#include <string>
 
 #include <unistd.h>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 
 #include "skelgraph/gesture/hmm.hpp"
 
@@ -101,6 +105,163 @@ TEST(Hmm, ForwardAndViterbiMatchBruteForce) {
   EXPECT_NEAR(lp, std::log(best), 1e-9);
   const MatrixXd post = h.posteriors(x);
   for (Eigen::Index t = 0; t < post.rows(); ++t) EXPECT_NEAR(post.row(t).sum(), 1.0, 1e-9);
+}
+
+// Posterior state probabilities against brute force: for every path of a
+// tiny model, P(path, x) with each emission evaluated directly from its
+// Gaussian formula; gamma[t][i] = sum of P(path, x) over paths in state i at
+// t, over P(x). Overlapping emissions keep the posteriors away from 0 and 1.
+TEST(Hmm, PosteriorsMatchBruteForce) {
+  const auto normal = [](double x, double mu, double sd) {
+    return std::exp(-0.5 * (x - mu) * (x - mu) / (sd * sd)) / std::sqrt(2 * M_PI * sd * sd);
+  };
+  struct Case {
+    VectorXd start;
+    MatrixXd a;
+    std::vector<std::vector<std::array<double, 3>>> mix;  // per state: {weight, mean, sd} per component
+    std::vector<double> x;
+  };
+  std::vector<Case> cases;
+  {
+    Case c;  // three states, one of them a two-component mixture
+    c.start = (VectorXd(3) << 0.5, 0.3, 0.2).finished();
+    c.a = (MatrixXd(3, 3) << 0.6, 0.3, 0.1, 0.2, 0.5, 0.3, 0.25, 0.15, 0.6).finished();
+    c.mix = {{{1.0, 0.0, 1.0}}, {{1.0, 1.2, 0.8}}, {{0.4, 2.5, 0.6}, {0.6, -0.5, 1.5}}};
+    c.x = {0.3, 1.7, -0.4, 2.9, 1.1};
+    cases.push_back(c);
+  }
+  {
+    Case c;  // two states, left-right (zeros in start and transitions), 4 frames
+    c.start = (VectorXd(2) << 1.0, 0.0).finished();
+    c.a = (MatrixXd(2, 2) << 0.7, 0.3, 0.0, 1.0).finished();
+    c.mix = {{{1.0, 0.0, 1.0}}, {{1.0, 1.0, 1.3}}};
+    c.x = {-0.2, 0.9, 0.4, 1.6};
+    cases.push_back(c);
+  }
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    const Case& c = cases[k];
+    const int n = static_cast<int>(c.start.size());
+    const int T = static_cast<int>(c.x.size());
+    std::vector<GaussianMixture> em;
+    for (const auto& comps : c.mix) {
+      GaussianMixture g;
+      g.weights.resize(static_cast<Eigen::Index>(comps.size()));
+      for (std::size_t m = 0; m < comps.size(); ++m) {
+        g.weights(static_cast<Eigen::Index>(m)) = comps[m][0];
+        g.means.push_back(VectorXd::Constant(1, comps[m][1]));
+        g.covs.push_back(MatrixXd::Constant(1, 1, comps[m][2] * comps[m][2]));
+      }
+      em.push_back(g);
+    }
+    Hmm h(n, 1, Covariance::Full);
+    h.set(c.start, c.a, em);
+    const auto emit = [&](int s, double x) {
+      double p = 0;
+      for (const auto& comp : c.mix[static_cast<std::size_t>(s)]) p += comp[0] * normal(x, comp[1], comp[2]);
+      return p;
+    };
+    MatrixXd joint = MatrixXd::Zero(T, n);  // sum of P(path, x) over paths in state i at t
+    double total = 0;
+    std::vector<int> path(static_cast<std::size_t>(T));
+    std::function<void(int, double)> walk = [&](int t, double p) {
+      if (t == T) {
+        total += p;
+        for (int u = 0; u < T; ++u) joint(u, path[static_cast<std::size_t>(u)]) += p;
+        return;
+      }
+      for (int s = 0; s < n; ++s) {
+        path[static_cast<std::size_t>(t)] = s;
+        const double step = t == 0 ? c.start(s) : c.a(path[static_cast<std::size_t>(t - 1)], s);
+        walk(t + 1, p * step * emit(s, c.x[static_cast<std::size_t>(t)]));
+      }
+    };
+    walk(0, 1.0);
+    ASSERT_GT(total, 0);
+    const MatrixXd want = joint / total;
+    const Sequence x = Eigen::Map<const VectorXd>(c.x.data(), T);
+    const MatrixXd got = h.posteriors(x);
+    ASSERT_EQ(got.rows(), T);
+    ASSERT_EQ(got.cols(), n);
+    for (int t = 0; t < T; ++t) {
+      for (int i = 0; i < n; ++i) EXPECT_NEAR(got(t, i), want(t, i), 1e-9) << "case " << k << ", t " << t << ", state " << i;
+    }
+    EXPECT_NEAR(h.log_likelihood(x), std::log(total), 1e-9) << "case " << k;
+    // The control: the posteriors are neither the filtered (forward-only)
+    // ones nor all near 0 or 1, so a wrong backward pass would show.
+    const Hmm::Pass fwd = h.pass(x, false);
+    double differ = 0, spread = 0;
+    for (int t = 0; t < T; ++t) {
+      for (int i = 0; i < n; ++i) {
+        differ = std::max(differ, std::abs(fwd.alpha(t, i) - want(t, i)));
+        spread = std::max(spread, std::min(want(t, i), 1 - want(t, i)));
+      }
+    }
+    EXPECT_GT(differ, 0.01) << "case " << k;
+    EXPECT_GT(spread, 0.1) << "case " << k;
+  }
+}
+
+// Degenerate training data: a feature constant over every frame (variance
+// exactly 0) and two features exactly equal (a rank-deficient covariance).
+// Regularisation must keep every covariance positive definite, full and
+// diagonal, with mixtures and either initialisation, and the likelihoods
+// finite. The control: the same training with regularisation 0 is refused.
+TEST(Hmm, RegularisationKeepsDegenerateCovariancesPositiveDefinite) {
+  std::mt19937_64 rng(12);
+  std::normal_distribution<double> noise(0, 0.3);
+  const auto sequence = [&](int T) {
+    Sequence x(T, 4);
+    for (int t = 0; t < T; ++t) {
+      const double v = 2.0 * (3 * t / T) + noise(rng);  // three phases: around 0, 2, 4
+      x.row(t) << v, 0.5, v, 0.1;                         // 0.5: its mean is exact, so the centred column is exactly 0
+    }
+    return x;
+  };
+  std::vector<Sequence> data;
+  for (int i = 0; i < 20; ++i) data.push_back(sequence(30 + i % 5));
+  const Sequence fresh = sequence(40);
+  for (const auto cov : {Covariance::Full, Covariance::Diagonal}) {
+    for (const int mixtures : {1, 2}) {
+      for (const auto init : {Init::Segments, Init::KMeans}) {
+        const std::string what = std::string(cov == Covariance::Full ? "full" : "diagonal") + ", " + std::to_string(mixtures) +
+                                 " mixtures, " + (init == Init::KMeans ? "kmeans" : "segments");
+        TrainOptions o;
+        o.states = 3;
+        o.mixtures = mixtures;
+        o.covariance = cov;
+        o.init = init;
+        o.max_iterations = 30;
+        Hmm h;
+        TrainReport rep;
+        ASSERT_NO_THROW(h = Hmm::train(data, o, &rep)) << what;
+        ASSERT_FALSE(rep.log_likelihood.empty()) << what;
+        for (const double ll : rep.log_likelihood) EXPECT_TRUE(std::isfinite(ll)) << what;
+        for (const auto& g : h.emissions()) {
+          for (const auto& s : g.covs) {
+            ASSERT_EQ(s.rows(), 4);
+            EXPECT_TRUE(s.allFinite()) << what;
+            EXPECT_TRUE(s.isApprox(s.transpose())) << what;
+            EXPECT_EQ(Eigen::LLT<MatrixXd>(s).info(), Eigen::Success) << what << "\n" << s;
+            EXPECT_GT(Eigen::SelfAdjointEigenSolver<MatrixXd>(s).eigenvalues().minCoeff(), 0.0) << what << "\n" << s;
+            if (cov == Covariance::Diagonal) {
+              EXPECT_EQ(s(0, 2), 0.0) << what;
+            }
+          }
+        }
+        for (const auto& x : data) EXPECT_TRUE(std::isfinite(h.log_likelihood(x))) << what;
+        EXPECT_TRUE(std::isfinite(h.log_likelihood(fresh))) << what;
+        EXPECT_NO_THROW(h.posteriors(fresh)) << what;
+        // A frame off by a hair (0.01) in a feature that never varied costs a
+        // bounded amount, not the -1e12 a variance of 1e-15 would charge.
+        Sequence nudged = fresh;
+        nudged.col(1).array() += 0.01;
+        EXPECT_GT(h.log_likelihood(nudged), h.log_likelihood(fresh) - 10.0 * static_cast<double>(fresh.rows())) << what;
+        // The control: without regularisation the constant feature's variance is 0.
+        o.regularisation = 0;
+        EXPECT_THROW(Hmm::train(data, o), ModelError) << what;
+      }
+    }
+  }
 }
 
 TEST(Hmm, LongSequencesDoNotUnderflowAndStreamingMatches) {

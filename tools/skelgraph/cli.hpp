@@ -32,6 +32,25 @@ struct GlobalOptions {
 // DDS settings: command line, then environment, then launch file, then defaults.
 runtime::DdsConfig make_config(const GlobalOptions& g, const runtime::LaunchSpec* spec = nullptr);
 
+// Progress of long work, on stderr so that stdout (tables, --json) stays
+// clean. On a terminal one line redrawn in place; otherwise (a log, CI) a
+// line at most every 10 s, plus the last one, so logs stay short. Disabled:
+// nothing. done() ends the line, keeping it or clearing it.
+class Progress {
+ public:
+  explicit Progress(bool enabled = true);
+  ~Progress() { done(); }
+  Progress(const Progress&) = delete;
+  Progress& operator=(const Progress&) = delete;
+  void operator()(const std::string& text, bool last = false);
+  void done(bool keep = true);
+
+ private:
+  bool enabled_, tty_;
+  std::string shown_;  // the line on the terminal now
+  std::chrono::steady_clock::time_point logged_{};
+};
+
 // Option checks with messages a user can read ("must be >= 0, got -3").
 extern const CLI::Validator kNonNegative;
 extern const CLI::Validator kPositive;

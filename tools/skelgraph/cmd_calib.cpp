@@ -183,8 +183,8 @@ nlohmann::json calibrate_one(const std::string& path, const SkelOptions& o, skel
     const double b = calib::median(calib::joint_distances(test_ref, test_oth, before, 0, upper, 2.0));
     const double a = calib::median(calib::joint_distances(test_ref, test_oth, chosen, chosen_offset, upper, 2.0));
     j["held_out_median_distance_cm"] = {{"before", num(cm(b))}, {"after", num(cm(a))}};
-    auto& names = j["held_out_joints"] = nlohmann::json::array();
-    for (auto jid : upper) names.push_back(skeleton::joint_name(jid));
+    auto& held_out = j["held_out_joints"] = nlohmann::json::array();
+    for (auto jid : upper) held_out.push_back(skeleton::joint_name(jid));
   }
   j["verdict"] = improved ? "calibrated: the fitted pose brings the sensors' skeletons closer than before"
                           : "kept the previous pose: the fit did not bring the skeletons closer on the data it saw";
@@ -292,6 +292,7 @@ int calib_intrinsics(const BoardOptions& o) {
   std::vector<std::vector<cv::Point2f>> found;
   std::vector<std::string> missed;
   cv::Size size;
+  Progress progress(!o.json);
   for (std::size_t i = 0; i < o.images.size(); ++i) {
     const cv::Mat grey = read_image(o.images[i], cv::IMREAD_GRAYSCALE);
     if (size.area() == 0) size = grey.size();
@@ -299,9 +300,14 @@ int calib_intrinsics(const BoardOptions& o) {
                                               ", the other images are " + std::to_string(size.width) + "x" + std::to_string(size.height));
     if (auto c = calib::find_corners(grey, board)) found.push_back(std::move(*c));
     else missed.push_back(o.images[i]);
-    if (!o.json) std::fprintf(stderr, "\rlooking for the board: %zu of %zu images", i + 1, o.images.size());
+    progress("looking for the board: " + std::to_string(i + 1) + " of " + std::to_string(o.images.size()) + " images",
+             i + 1 == o.images.size());
   }
-  if (!o.json) std::fprintf(stderr, "\n");
+  if (found.size() < 3) {
+    throw UsageError("the " + o.size + " board (inner corners, columns x rows) was found in " + std::to_string(found.size()) +
+                     " of " + std::to_string(o.images.size()) +
+                     " images; intrinsics need it in 3 or more (is --board right? a 10x7-square board has 9x6 inner corners)");
+  }
   calib::IntrinsicsResult r;
   try {
     r = calib::calibrate_intrinsics(found, board, size);
@@ -387,6 +393,7 @@ int calib_board(const BoardOptions& o) {
   std::vector<double> marker_rms;
   const auto names = view_names(o.ref_dir);
   if (names.empty()) throw UsageError(o.ref_dir + ": no NAME_color.png views");
+  Progress progress(!o.json);
   for (std::size_t i = 0; i < names.size(); ++i) {
     const auto& n = names[i];
     std::vector<std::vector<Eigen::Vector3d>> lifted(dirs.size());
@@ -418,7 +425,7 @@ int calib_board(const BoardOptions& o) {
         skipped.push_back(n + ": " + e.what());
       }
     }
-    if (!o.json) std::fprintf(stderr, "\rviews: %zu of %zu read", i + 1, names.size());
+    progress("views: " + std::to_string(i + 1) + " of " + std::to_string(names.size()) + " read", i + 1 == names.size());
     if (!ok) continue;
     if (world) {
       // The board in the world from its markers, then its corners there.
@@ -439,7 +446,6 @@ int calib_board(const BoardOptions& o) {
     }
     used.push_back(n);
   }
-  if (!o.json) std::fprintf(stderr, "\n");
   if (ref.size() < 3) throw UsageError("the board was usable in only " + std::to_string(ref.size()) + " views (need 3): " + (skipped.empty() ? "" : skipped.front()));
   calib::RansacResult r;
   try {
@@ -461,7 +467,10 @@ int calib_board(const BoardOptions& o) {
                    {"skipped", skipped}, {"reference_from_other", pose_json(ref_from_other)},
                    {"corners", corners}, {"inliers", r.inliers.size()},
                    {"rms_residual_cm", cm(r.fit.rms)}, {"max_residual_cm", cm(r.fit.max)},
-                   {"verdict", good ? "good: corners agree within 1 cm RMS" : "poor: corners disagree (RMS 1 cm or more, or over 10 % outliers): check the intrinsics and that the depth is registered"}};
+                   {"verdict", good ? std::string("good: corners agree within 1 cm RMS")
+                                    : std::string("poor: corners disagree (RMS 1 cm or more, or over 10 % outliers): check the "
+                                                  "intrinsics and that the depth is registered") +
+                                          (world ? ", and that --square and the marker file describe this board" : "")}};
   if (world) {
     double worst = 0;
     for (double m : marker_rms) worst = std::max(worst, m);

@@ -15,7 +15,6 @@
 #include <queue>
 #include <sstream>
 
-#include <unistd.h>
 
 #include <nlohmann/json.hpp>
 
@@ -345,14 +344,14 @@ void stream_recording(const RecordingInputs& in, eval::Evaluator& ev, const Mess
   std::int64_t latest = std::numeric_limits<std::int64_t>::min();
   // Progress on a terminal, for recordings that take a while (over ~10 minutes of two sensors).
   const std::uint64_t total = in.raw + in.truth + in.fused;
-  const bool progress = total > 40'000 && isatty(fileno(stderr));
+  Progress progress(total > 40'000);
   try {
     const mcap::Reader reader(in.file);
     reader.for_each_message([&](const mcap::Channel& ch, const mcap::Schema* schema, const mcap::Message& m) {
       if (const auto kind = skeleton_kind(ch, schema)) {
-        if (progress && seq % 5000 == 0)
-          std::fprintf(stderr, "\r%s: %llu of %llu skeletons fused and scored (%.0f %%)   ", in.file.c_str(),
-                       static_cast<unsigned long long>(seq), static_cast<unsigned long long>(total), 100.0 * seq / total);
+        if (seq % 5000 == 0)
+          progress(in.file + ": " + std::to_string(seq) + " of " + std::to_string(total) + " skeletons fused and scored (" +
+                   std::to_string(100 * seq / total) + " %)");
         const auto t = static_cast<std::int64_t>(m.log_time);
         latest = std::max(latest, t);
         held.push({{*kind, t, skeleton_of(m)}, seq++});
@@ -367,7 +366,7 @@ void stream_recording(const RecordingInputs& in, eval::Evaluator& ev, const Mess
     throw UsageError(e.what());
   }
   for (; !held.empty(); held.pop()) ev.add(held.top().e);
-  if (progress) std::fprintf(stderr, "\r%*s\r", static_cast<int>(in.file.size()) + 60, "");
+  progress.done(false);
 }
 
 struct FileOptions {
@@ -576,7 +575,7 @@ int eval_sim(const SimEvalOptions& o) {
     for (const auto& s : cfg.sensors) poses[s.id] = s.world_from_sensor();
     std::vector<eval::TimedSkeleton> events;
     eval::OfflineResult r;
-    const bool progress = !o.json && !o.quiet;
+    Progress progress(!o.json && !o.quiet);
     nlohmann::json depth_info;
     if (o.source == "depth" || o.source == "depth-merged") {
       depth_tracker::SimDepthOptions dopt;
@@ -588,7 +587,7 @@ int eval_sim(const SimEvalOptions& o) {
       } catch (const std::invalid_argument& e) {
         throw UsageError(e.what());
       }
-      if (progress) std::fprintf(stderr, "\rrendering and tracking depth for %s...      ", scenario.c_str());
+      progress("rendering and tracking depth for " + scenario + "...");
       auto d = depth_tracker::track_simulated_depth(cfg, dopt);
       events = std::move(d.events);
       depth_info = {{"frames", d.frames},
@@ -609,18 +608,19 @@ int eval_sim(const SimEvalOptions& o) {
           ev.add({e.kind == sim::SimEvent::Kind::Truth ? eval::TimedSkeleton::Kind::Truth : eval::TimedSkeleton::Kind::Raw,
                   t, std::move(e.skeleton)});
         }
-        if (progress)
-          std::fprintf(stderr, "\rsimulating and evaluating %s: %.0f of %.0f s...      ", scenario.c_str(),
-                       std::min(until, end), end);
+        char text[96];
+        std::snprintf(text, sizeof text, "simulating and evaluating %s: %.0f of %.0f s...", scenario.c_str(),
+                      std::min(until, end), end);
+        progress(text);
         if (until >= end) break;
       }
       r = ev.finish();
     }
     if (!events.empty()) {
-      if (progress) std::fprintf(stderr, "\revaluating %s (%zu events)...      ", scenario.c_str(), events.size());
+      progress("evaluating " + scenario + " (" + std::to_string(events.size()) + " events)...");
       r = eval::evaluate(poses, events, eo);
     }
-    if (progress) std::fprintf(stderr, "\r%50s\r", "");
+    progress.done(false);
     if (o.quiet) std::fprintf(stderr, "evaluated %s: %zu streams over %llu ticks\n", scenario.c_str(), r.streams.size(),
                               static_cast<unsigned long long>(r.ticks));
     nlohmann::json streams = nlohmann::json::array();

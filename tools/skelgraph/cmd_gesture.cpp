@@ -10,7 +10,6 @@
 #include <set>
 #include <tuple>
 
-#include <unistd.h>
 
 #include <nlohmann/json.hpp>
 
@@ -163,10 +162,9 @@ CvOptions cv_options(const GestureOptions& o) {
 
 CvRun run_cv(const GestureOptions& o, const ClassMap& map, const std::vector<Clip>& clips, const ClassifierOptions& c,
              const std::string& what) {
+  Progress progress;
   const auto results = cross_validate(clips, map, c, cv_options(o), [&](int done, int total) {
-    static const bool tty = isatty(fileno(stderr));
-    std::fprintf(stderr, tty ? "\r%s: fold %d/%d" : "%s: fold %d/%d\n", what.c_str(), done, total);
-    if (tty && done == total) std::fprintf(stderr, "\n");
+    progress(what + ": fold " + std::to_string(done) + "/" + std::to_string(total), done == total);
   });
   return {c, evaluate(results, map.classes), results};
 }
@@ -213,10 +211,9 @@ int gesture_cv(const GestureOptions& o) {
   std::optional<NestedCv> nested;
   Metrics nested_metrics;
   if (o.nested) {
+    Progress progress;
     nested = nested_cross_validate(clips, map, configs, cv_options(o), [&](int done, int total) {
-      static const bool tty = isatty(fileno(stderr));
-      std::fprintf(stderr, tty ? "\rnested: outer fold %d/%d" : "nested: outer fold %d/%d\n", done, total);
-      if (tty && done == total) std::fprintf(stderr, "\n");
+      progress("nested: outer fold " + std::to_string(done) + "/" + std::to_string(total), done == total);
     });
     nested_metrics = evaluate(nested->results, map.classes);
   }
@@ -343,7 +340,7 @@ int gesture_spot(const GestureOptions& o) {
   std::vector<SpottingReport> reports;
   nlohmann::json per = nlohmann::json::array();
   int done = 0;
-  const bool tty = isatty(fileno(stderr));
+  Progress progress;
   for (const auto& [subject, idx] : by_subject) {
     std::vector<Clip> train;
     for (std::size_t i = 0; i < clips.size(); ++i)
@@ -457,9 +454,9 @@ int gesture_spot(const GestureOptions& o) {
     per.push_back({{"subject", subject}, {"clips", idx.size()}, {"truth", r.truth}, {"events", r.events},
                    {"true_positive", r.true_positive}, {"f1", r.f1}, {"spotted", ev}, {"clips_in_stream", tj}});
     ++done;
-    std::fprintf(stderr, tty ? "\rspotted subject %d/%zu" : "spotted subject %d/%zu\n", done, by_subject.size());
+    progress("spotted subject " + std::to_string(done) + "/" + std::to_string(by_subject.size()),
+             static_cast<std::size_t>(done) == by_subject.size());
   }
-  if (tty) std::fprintf(stderr, "\n");
   const auto r = combine(reports);
   if (o.json) {
     std::printf("%s\n", nlohmann::json{{"label", label}, {"config", config_json(c)}, {"gap_s", o.gap}, {"rest_s", o.rest}, {"spotting", to_json(r)},
@@ -550,10 +547,9 @@ nlohmann::json event_json(const SpottedEvent& e) {
 int gesture_sim(const GestureOptions& o) {
   auto c = classifier_options(o);
   c.trimmed = sim_classifier_options().trimmed;
-  const bool tty = isatty(fileno(stderr));
+  Progress line;
   const auto progress = [&](const char* what, int done, int total) {
-    std::fprintf(stderr, tty ? "\r%s: session %d/%d" : "%s: session %d/%d\n", what, done, total);
-    if (tty && done == total) std::fprintf(stderr, "\n");
+    line(std::string(what) + ": session " + std::to_string(done) + "/" + std::to_string(total), done == total);
   };
   std::size_t clips = 0;
   const auto model = train_on_sim(o.train_sessions, o.seed, c, &clips,

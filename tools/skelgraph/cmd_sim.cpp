@@ -40,12 +40,13 @@ int table(const sim::RealismOptions& opt, bool json, bool check) {
       std::printf("\n");
     }
     std::vector<sim::Figures> sims, refs;
+    Progress progress;
     for (const auto& s : sim::kThesisScenarios) {
-      std::fprintf(stderr, "\rsimulating %s %s...      ", profile.c_str(), s.c_str());
+      progress("simulating " + profile + " " + s + "...");
       sims.push_back(sim::simulate_figures(s, profile, opt));
       refs.push_back(sim::thesis_figures(s, profile));
     }
-    std::fprintf(stderr, "\r%40s\r", "");
+    progress.done(false);
     for (std::size_t g = 0; g < sim::kGroupCount; ++g) {
       if (!json) std::printf("%-6s %-10s", "", sim::group_names()[g]);
       for (std::size_t k = 0; k < sims.size(); ++k) {
@@ -244,6 +245,7 @@ int export_run(const std::vector<std::string>& assignments, const std::string& d
   std::ofstream phases(std::filesystem::path(dir) / "phases.csv");
   phases << "stamp_ns,person_id,phase\n";
   const double step = 5.0;  // s of simulated time per batch (progress)
+  Progress progress(!json);
   for (double t = step;; t += step) {
     for (auto& e : sim.advance(t)) {
       if (e.kind == sim::SimEvent::Kind::Truth) {
@@ -255,10 +257,11 @@ int export_run(const std::vector<std::string>& assignments, const std::string& d
         raw[e.sensor].frames.push_back(std::move(e.skeleton));
       }
     }
-    if (!json) std::fprintf(stderr, "\rsimulated %.0f of %.0f s", std::min(t, sim.duration()), sim.duration());
+    char text[64];
+    std::snprintf(text, sizeof text, "simulated %.0f of %.0f s", std::min(t, sim.duration()), sim.duration());
+    progress(text, sim.finished());
     if (sim.finished()) break;
   }
-  if (!json) std::fprintf(stderr, "\n");
   nlohmann::json files = nlohmann::json::object();
   write_file(std::filesystem::path(dir) / "truth.csv", truth);
   files["truth.csv"] = truth.frames.size();

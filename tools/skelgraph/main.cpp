@@ -4,6 +4,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
+#include <string>
+
+#include <unistd.h>
 
 #include <fastdds/dds/log/Log.hpp>
 #include <fastdds/dds/log/StdoutErrConsumer.hpp>
@@ -51,6 +54,30 @@ CLI::Validator number_check(bool allow_zero) {
       allow_zero ? "NUMBER>=0" : "NUMBER>0");
 }
 }  // namespace
+
+Progress::Progress(bool enabled) : enabled_(enabled), tty_(isatty(fileno(stderr)) != 0) {}
+
+void Progress::operator()(const std::string& text, bool last) {
+  if (!enabled_) return;
+  if (tty_) {
+    const std::size_t pad = shown_.size() > text.size() ? shown_.size() - text.size() : 0;
+    std::fprintf(stderr, "\r%s%*s", text.c_str(), static_cast<int>(pad), "");
+    shown_ = text;
+    if (last) done();
+    return;
+  }
+  const auto now = std::chrono::steady_clock::now();
+  if (!last && logged_ != std::chrono::steady_clock::time_point{} && now - logged_ < std::chrono::seconds(10)) return;
+  std::fprintf(stderr, "%s\n", text.c_str());
+  logged_ = now;
+}
+
+void Progress::done(bool keep) {
+  if (!enabled_ || !tty_ || shown_.empty()) return;
+  if (keep) std::fprintf(stderr, "\n");
+  else std::fprintf(stderr, "\r%*s\r", static_cast<int>(shown_.size()), "");
+  shown_.clear();
+}
 
 const CLI::Validator kNonNegative = number_check(true);
 const CLI::Validator kPositive = number_check(false);

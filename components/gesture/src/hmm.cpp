@@ -454,8 +454,14 @@ Hmm Hmm::train(const std::vector<Sequence>& data, const TrainOptions& o, TrainRe
   mean /= static_cast<double>(frames);
   for (const auto& x : data) var += (x.rowwise() - mean.transpose()).array().square().colwise().sum().matrix().transpose();
   var /= static_cast<double>(frames);
-  const VectorXd reg = o.regularisation * var.cwiseMax(1e-12);
-  const MatrixXd global_cov = MatrixXd(var.cwiseMax(1e-12).asDiagonal());
+  // A feature that never varies in training (a joint a recording lacks,
+  // filled with a constant) has no spread of its own to scale by: it takes the
+  // features' mean spread, so that a test frame off by a hair in it is not
+  // worth -1e12 (with 1e-12 it was; any feature with some spread is unchanged).
+  const double typical = var.mean() > 1e-12 ? var.mean() : 1.0;
+  const VectorXd spread = var.unaryExpr([&](double v) { return v > 1e-12 ? v : typical; });
+  const VectorXd reg = o.regularisation * spread;
+  const MatrixXd global_cov = MatrixXd(spread.asDiagonal());
 
   // Initialisation (Init::Segments): each sequence cut into N equal parts,
   // state j taking the j-th part of every sequence; (Init::KMeans) a state
