@@ -81,15 +81,6 @@ struct DemoOptions {
   std::string report = "skelgraph-demo-report";
 };
 
-// The recording the recorder closed during the run, if any.
-std::string recorded_file(const runtime::Graph& graph) {
-  for (const auto& r : graph.report()) {
-    if (r.kind != "recorder") continue;
-    for (const auto& f : r.details.value("files", nlohmann::json::array())) return f.value("file", "");
-  }
-  return {};
-}
-
 void print_live(const nlohmann::json& seen) {
   for (const auto& s : seen["sessions"]) {
     std::printf("session %u '%s': START %s, %llu ticks at %.2f Hz (arrival period %.1f-%.1f ms, std %.2f ms), "

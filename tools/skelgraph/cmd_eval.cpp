@@ -23,11 +23,13 @@
 #include "skelgraph/depth_tracker/sim_depth.hpp"
 #include "skelgraph/sim/sim_component.hpp"
 #include "report.hpp"
+#include "run_graph.hpp"
 #include "skelgraph/calib/calib_file.hpp"
 #include "skelgraph/eval/offline.hpp"
 #include "skelgraph/mcap/mcap.hpp"
 #include "skelgraph/msg/cdr.hpp"
 #include "skelgraph/recording/bag.hpp"
+#include "skelgraph/runtime/registry.hpp"
 #include "skelgraph/runtime/topics.hpp"
 #include "skelgraph/skeleton/skeleton_msg.hpp"
 #include "skelgraph/sim/sim_component.hpp"
@@ -454,6 +456,50 @@ int eval_file(const FileOptions& o) {
   return 0;
 }
 
+// skelgraph eval live: what is on the domain now (raw skeletons, calibration,
+// sync ticks, truth and fused skeletons if published) recorded for a while
+// by a recorder in this process, then scored as `eval recording` scores a
+// file. The recording is kept, so the figures can be checked and re-run.
+struct LiveOptions {
+  FileOptions score;      // methods, --json, --report, --csv (file: the recording made)
+  double duration = 30.0;  // s
+  std::string dir;         // where the recording goes (default: a fresh directory under the temp dir)
+};
+
+int eval_live(const LiveOptions& o, GlobalOptions& g) {
+  const auto registry = runtime::builtin_registry();
+  std::string dir = o.dir;
+  if (dir.empty()) {
+    std::string t = (std::filesystem::temp_directory_path() / "skelgraph-eval-live-XXXXXX").string();
+    if (mkdtemp(t.data()) == nullptr) throw std::runtime_error("cannot make a directory under " + t);
+    dir = t;
+  }
+  runtime::ResolvedComponent rec;
+  rec.name = "eval_recorder";
+  rec.kind = "recorder";
+  try {
+    rec.params = registry.find("recorder")->info.params.resolve(
+        {{"directory", dir, "eval live --dir"}, {"now", "true", "eval live"}, {"label", "eval_live", "eval live"}},
+        "eval live");
+  } catch (const runtime::ParamError& e) {
+    throw UsageError(e.what());
+  }
+  const auto config = make_config(g);
+  std::fprintf(stderr, "recording the skeleton topics on domain %d (profile %s) for %.0f s into %s (Ctrl-C ends it sooner)\n",
+               config.domain, config.profile.c_str(), o.duration, dir.c_str());
+  RunOptions ro;
+  ro.duration_s = o.duration;
+  std::string file;
+  const int rc = run_graph(registry, config, {rec}, ro,
+                           [&](runtime::Graph& graph, nlohmann::json&) { file = recorded_file(graph); });
+  if (rc != 0) return rc;
+  if (file.empty()) throw std::runtime_error("the recorder wrote no file into " + dir);
+  std::fprintf(stderr, "scoring %s\n", file.c_str());
+  FileOptions f = o.score;
+  f.file = file;
+  return eval_file(f);
+}
+
 // skelgraph fuse IN --out OUT: the recording with fused skeletons added on
 // skelgraph/skeleton/fused (sensor_id "fused", or "fused_<method>" for several).
 int fuse_file(const FileOptions& o) {
@@ -685,7 +731,7 @@ void add_fuse_command(CLI::App& app, GlobalOptions&, Action& run) {
   });
 }
 
-void add_eval_command(CLI::App& app, GlobalOptions&, Action& run) {
+void add_eval_command(CLI::App& app, GlobalOptions& g, Action& run) {
   auto* ev = app.add_subcommand("eval", "Score single sensors and fusion methods against ground truth");
   ev->require_subcommand(1);
   auto o = std::make_shared<SimEvalOptions>();
@@ -721,6 +767,23 @@ void add_eval_command(CLI::App& app, GlobalOptions&, Action& run) {
                 "also write DIR/report.html (table, inline SVG plots), each plot as SVG and the table as CSV");
   r->add_option("--csv", fo->csv, "also write the table as CSV to this file (a row per stream)");
   r->callback([fo, &run] { run = [fo] { return eval_file(*fo); }; });
+
+  auto lo = std::make_shared<LiveOptions>();
+  auto* l = ev->add_subcommand("live",
+                               "What a running cell publishes now (raw skeletons, poses, sync ticks; truth and fused "
+                               "skeletons if published), recorded for a while and scored as `eval recording` scores a file");
+  l->add_option("--duration", lo->duration, "seconds to record (Ctrl-C ends it sooner)")->check(kPositive);
+  l->add_option("--dir", lo->dir, "directory for the recording (kept; default: a new one under the temp directory)");
+  add_fusion_options(l, lo->score.methods, lo->score.delay_ms, lo->score.max_age_ms, "fusion methods (default: all)");
+  l->add_flag("--json", lo->score.json, "machine-readable results");
+  l->add_flag("--shared-frame", lo->score.shared_frame, "the sensors' skeletons are already in one frame: no poses needed");
+  l->add_option("--calibration", lo->score.calibration, "sensor poses from this calibration file (YAML) instead of the topic's")
+      ->check(CLI::ExistingFile);
+  l->add_option("--report", lo->score.report_dir,
+                "also write DIR/report.html (table, inline SVG plots), each plot as SVG and the table as CSV");
+  l->add_option("--csv", lo->score.csv, "also write the table as CSV to this file (a row per stream)");
+  add_dds_options(*l, g);
+  l->callback([lo, &g, &run] { run = [lo, &g] { return eval_live(*lo, g); }; });
 }
 
 }  // namespace skelgraph::cli

@@ -27,6 +27,14 @@ void add_run_options(CLI::App& cmd, RunOptions& options) {
   cmd.add_flag("--json", options.json, "print the final report as JSON on stdout");
 }
 
+std::string recorded_file(const runtime::Graph& graph) {
+  for (const auto& r : graph.report()) {
+    if (r.kind != "recorder") continue;
+    for (const auto& f : r.details.value("files", nlohmann::json::array())) return f.value("file", "");
+  }
+  return {};
+}
+
 int run_graph(const runtime::ComponentRegistry& registry, const runtime::DdsConfig& config,
               const std::vector<runtime::ResolvedComponent>& components, const RunOptions& options,
               const std::function<void(runtime::Graph&, nlohmann::json&)>& extra_report) {

@@ -3,6 +3,7 @@
 // printing a status line per component at start, on request and at the end.
 
 #include <functional>
+#include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -30,5 +31,8 @@ void add_run_options(CLI::App& cmd, RunOptions& options);
 int run_graph(const runtime::ComponentRegistry& registry, const runtime::DdsConfig& config,
               const std::vector<runtime::ResolvedComponent>& components, const RunOptions& options,
               const std::function<void(runtime::Graph&, nlohmann::json&)>& extra_report);
+
+// The first recording a recorder component of the graph wrote, if any.
+std::string recorded_file(const runtime::Graph& graph);
 
 }  // namespace skelgraph::cli
