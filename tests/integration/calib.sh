@@ -35,8 +35,10 @@ PY
 compare_pose "$WORK/truth.yaml" "$WORK/calib.yaml" 0.03 1.0 || fail "skeleton calibration against the truth"
 ok "skeleton calibration: sensor2 within 3 cm and 1 degree of the truth"
 # --holdout on the same walk: fitted on the first half, the upper body's distance measured on the second.
-"$S" calib skeleton "$WORK/walk.mcap" --ref sensor1 --holdout --json >"$WORK/holdout.json" 2>"$WORK/calib.err" \
+"$S" calib skeleton "$WORK/walk.mcap" --ref sensor1 --holdout --best-rigid --json >"$WORK/holdout.json" 2>"$WORK/calib.err" \
   || fail "calib skeleton --holdout: $(cat "$WORK/calib.err")"
+# --best-rigid: the lowest held-out median a rigid pose reaches on that half itself, no more than the fit's.
+json_check "$WORK/holdout.json" '0 < d[0]["held_out_best_rigid_median_cm"] <= d[0]["held_out_median_distance_cm"]["after"] + 0.05' 
 json_check "$WORK/holdout.json" 'd[0]["held_out_joints"] == ["head", "neck", "torso", "left_shoulder", "right_shoulder", "left_elbow", "right_elbow", "left_hand", "right_hand"] and d[0]["held_out_median_distance_cm"]["after"] < d[0]["held_out_median_distance_cm"]["before"]'
 ok "calib --holdout: upper-body distance on the unseen half, $(python3 -c 'import json,sys; h=json.load(open(sys.argv[1]))[0]["held_out_median_distance_cm"]; print("%.1f -> %.1f cm" % (h["before"], h["after"]))' "$WORK/holdout.json")"
 

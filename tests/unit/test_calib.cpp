@@ -241,6 +241,28 @@ TEST(SkeletonCalib, HeldOutDistancesShrink) {
   EXPECT_LT(after, 0.08);
 }
 
+// The floor search (calib skeleton --best-rigid): started 5 cm and 3 degrees
+// off, it comes back to about the true pose and ends with a median at least
+// as low as the true pose's on the same data, and lower than its start.
+TEST(SkeletonCalib, TheLowestMedianPoseBeatsItsStartAndTheTruth) {
+  const auto p = simulate("walk", 1, 30);
+  const auto at = [&](const Eigen::Isometry3d& x) { return calib::median(calib::joint_distances(p.ref, p.other, x)); };
+  Eigen::Isometry3d off = p.truth;
+  off.pretranslate(Vector3d(0.05, 0.0, 0.0));
+  off.prerotate(Eigen::AngleAxisd(3.0 * M_PI / 180.0, Vector3d::UnitY()).toRotationMatrix());
+  const auto low = calib::lowest_median_pose(p.ref, p.other, off);
+  EXPECT_DOUBLE_EQ(low.start_median_m, at(off));
+  EXPECT_DOUBLE_EQ(low.median_m, at(low.reference_from_other));
+  EXPECT_LT(low.median_m, 0.8 * low.start_median_m);
+  EXPECT_LE(low.median_m, at(p.truth) + 1e-3);
+  const double angle = calib::rotation_angle_deg(low.reference_from_other.linear() * p.truth.linear().transpose());
+  const double dist = (low.reference_from_other.translation() - p.truth.translation()).norm();
+  std::printf("start %.2f cm, truth %.2f cm, found %.2f cm, %.2f deg and %.2f cm from the truth\n", 100 * low.start_median_m,
+              100 * at(p.truth), 100 * low.median_m, angle, 100 * dist);
+  EXPECT_LT(angle, 1.5);  // the median is flat near its lowest point (found 0.8 degrees, 2.9 cm from the truth)
+  EXPECT_LT(dist, 0.04);
+}
+
 TEST(SkeletonCalib, NothingToSolveIsAClearError) {
   const auto p = simulate("walk", 1, 5);
   std::vector<calib::TimedSkeleton> late = p.other;

@@ -1,6 +1,7 @@
 #include "skelgraph/calib/skeleton_calib.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -215,8 +216,8 @@ SkeletonCalibResult solve(const std::vector<Candidate>& cs, Alignment pose, cons
     std::vector<double> w;
     const double c = o.robust_scale_m;
     for (std::size_t k = 0; k < a.size(); ++k) {
-      const double r = (pose.apply(a[k]) - b[k]).norm();
-      w.push_back(c > 0 && round > 0 ? 1.0 / (1.0 + (r / c) * (r / c)) : 1.0);
+      const double d = (pose.apply(a[k]) - b[k]).norm();
+      w.push_back(c > 0 && round > 0 ? 1.0 / (1.0 + (d / c) * (d / c)) : 1.0);
     }
     const Alignment fit = align(a, b, w);
     const double moved = (fit.t - pose.t).norm() + 0.01 * rotation_angle_deg(fit.R * pose.R.transpose());
@@ -316,6 +317,69 @@ std::vector<double> joint_distances(const std::vector<TimedSkeleton>& reference,
     }
     if (best <= max_match_m) out.insert(out.end(), best_d.begin(), best_d.end());
   }
+  return out;
+}
+
+LowestMedian lowest_median_pose(const std::vector<TimedSkeleton>& reference, const std::vector<TimedSkeleton>& other,
+                                const Eigen::Isometry3d& start, std::int64_t clock_offset_ns,
+                                const std::vector<JointId>& joints, double max_match_m) {
+  using V6 = Eigen::Matrix<double, 6, 1>;
+  const auto pose_of = [&](const V6& x) {
+    Eigen::Isometry3d d = Eigen::Isometry3d::Identity();
+    const Vector3d w = x.head<3>();
+    if (w.norm() > 0) d.linear() = Eigen::AngleAxisd(w.norm(), w.normalized()).toRotationMatrix();
+    d.translation() = x.tail<3>();
+    return Eigen::Isometry3d(d * start);
+  };
+  const auto cost = [&](const V6& x) {
+    const double m = median(joint_distances(reference, other, pose_of(x), clock_offset_ns, joints, max_match_m));
+    return std::isfinite(m) ? m : std::numeric_limits<double>::infinity();
+  };
+  LowestMedian out;
+  V6 best = V6::Zero();
+  double best_f = out.start_median_m = cost(best);
+  // Steps: 2 degrees and 5 cm, then a third and a ninth of that.
+  for (double scale : {1.0, 1.0 / 3, 1.0 / 9}) {
+    std::array<V6, 7> x;
+    std::array<double, 7> f;
+    for (auto& v : x) v = best;
+    for (int i = 0; i < 6; ++i) x[static_cast<std::size_t>(i + 1)][i] += scale * (i < 3 ? 0.035 : 0.05);
+    for (std::size_t i = 0; i < 7; ++i) f[i] = cost(x[i]);
+    for (int it = 0; it < 400; ++it) {
+      std::array<std::size_t, 7> ord{0, 1, 2, 3, 4, 5, 6};
+      std::sort(ord.begin(), ord.end(), [&](std::size_t a, std::size_t b) { return f[a] < f[b]; });
+      std::array<V6, 7> xs;
+      std::array<double, 7> fs;
+      for (std::size_t i = 0; i < 7; ++i) xs[i] = x[ord[i]], fs[i] = f[ord[i]];
+      x = xs, f = fs;
+      if (f[6] - f[0] < 1e-6) break;  // a hundredth of a millimetre
+      V6 c = V6::Zero();
+      for (std::size_t i = 0; i < 6; ++i) c += x[i];
+      c /= 6;
+      const V6 xr = c + (c - x[6]);
+      const double fr = cost(xr);
+      if (fr < f[0]) {
+        const V6 xe = c + 2 * (c - x[6]);
+        const double fe = cost(xe);
+        if (fe < fr) x[6] = xe, f[6] = fe;
+        else x[6] = xr, f[6] = fr;
+      } else if (fr < f[5]) {
+        x[6] = xr, f[6] = fr;
+      } else {
+        const V6 xc = c + 0.5 * (x[6] - c);
+        const double fc = cost(xc);
+        if (fc < f[6]) {
+          x[6] = xc, f[6] = fc;
+        } else {
+          for (std::size_t i = 1; i < 7; ++i) x[i] = x[0] + 0.5 * (x[i] - x[0]), f[i] = cost(x[i]);
+        }
+      }
+    }
+    const auto k = static_cast<std::size_t>(std::min_element(f.begin(), f.end()) - f.begin());
+    if (f[k] < best_f) best_f = f[k], best = x[k];
+  }
+  out.reference_from_other = pose_of(best);
+  out.median_m = best_f;
   return out;
 }
 

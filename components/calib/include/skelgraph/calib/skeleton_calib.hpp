@@ -79,6 +79,22 @@ std::vector<double> joint_distances(const std::vector<TimedSkeleton>& reference,
                                     const std::vector<skeleton::JointId>& joints = {}, double max_match_m = 1.0,
                                     std::int64_t max_gap_ns = 70'000'000);
 
+// The rigid pose near `start` with the lowest median of joint_distances()
+// on the given data, by a local search (Nelder-Mead over a rotation vector
+// and a translation applied on top of `start`, restarted twice from the best
+// with smaller steps; deterministic). Run on the very data a calibration is
+// scored on, it says what no rigid pose nearby can beat there: how much of
+// the remaining disagreement is the pose and how much the trackers' own
+// (a view-dependent placement no rigid transform removes).
+struct LowestMedian {
+  Eigen::Isometry3d reference_from_other = Eigen::Isometry3d::Identity();
+  double median_m = 0;       // at that pose
+  double start_median_m = 0;  // at `start`
+};
+LowestMedian lowest_median_pose(const std::vector<TimedSkeleton>& reference, const std::vector<TimedSkeleton>& other,
+                                const Eigen::Isometry3d& start, std::int64_t clock_offset_ns = 0,
+                                const std::vector<skeleton::JointId>& joints = {}, double max_match_m = 1.0);
+
 double median(std::vector<double> v);  // NaN when empty
 
 }  // namespace skelgraph::calib
