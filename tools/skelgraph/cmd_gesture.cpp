@@ -257,6 +257,8 @@ int gesture_cv(const GestureOptions& o) {
         auto e = config_json(r.config);
         e["accuracy"] = r.metrics.accuracy;
         e["f1_" + map.classes[0]] = r.metrics.f1[0];
+        // the last tie-breaker of the choice (null where there is no detection ROC)
+        e["detection_auc"] = std::isfinite(r.metrics.detection_auc) ? nlohmann::json(r.metrics.detection_auc) : nlohmann::json();
         s.push_back(e);
       }
     }
