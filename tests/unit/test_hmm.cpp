@@ -264,6 +264,52 @@ TEST(Hmm, RegularisationKeepsDegenerateCovariancesPositiveDefinite) {
   }
 }
 
+// Two models compared by their scores (as a classifier compares its classes)
+// trained on data with one extra feature that never varies: with a spread
+// they share for it, the extra feature moves both scores by the same amount,
+// so the difference between them is what it is without the feature. Each
+// model's own mean spread instead would shift one against the other.
+TEST(Hmm, AConstantFeatureShiftsNoModelAgainstAnotherWithASharedSpread) {
+  std::mt19937_64 rng(5);
+  const auto data_of = [&](double scale) {
+    std::normal_distribution<double> noise(0, scale);
+    std::vector<Sequence> d;
+    for (int i = 0; i < 15; ++i) {
+      Sequence x(40, 2);
+      for (int t = 0; t < 40; ++t) x.row(t) << (t < 20 ? 0.0 : 1.0) + noise(rng), noise(rng);
+      d.push_back(x);
+    }
+    return d;
+  };
+  const auto with_constant = [](std::vector<Sequence> d) {
+    for (auto& x : d) {
+      Sequence y(x.rows(), 3);
+      y << x, Eigen::VectorXd::Constant(x.rows(), 0.5);
+      x = y;
+    }
+    return d;
+  };
+  const auto a = data_of(0.1), b = data_of(0.6);  // the two models' features spread differently
+  const Sequence test = data_of(0.3).front();
+  Sequence test3(test.rows(), 3);
+  test3 << test, Eigen::VectorXd::Constant(test.rows(), 0.5);
+  TrainOptions o;
+  o.states = 2;
+  o.covariance = Covariance::Diagonal;
+  const double gap = Hmm::train(a, o).log_likelihood(test) - Hmm::train(b, o).log_likelihood(test);
+  TrainOptions shared = o;
+  shared.constant_spread = Eigen::Vector3d(0.2, 0.2, 0.2);
+  const double gap3 = Hmm::train(with_constant(a), shared).log_likelihood(test3) -
+                      Hmm::train(with_constant(b), shared).log_likelihood(test3);
+  EXPECT_NEAR(gap3, gap, 1e-6 * std::abs(gap));
+  // The control: each model's own mean spread for the constant feature.
+  const double own = Hmm::train(with_constant(a), o).log_likelihood(test3) - Hmm::train(with_constant(b), o).log_likelihood(test3);
+  EXPECT_GT(std::abs(own - gap), 1.0);
+  TrainOptions wrong = o;
+  wrong.constant_spread = Eigen::Vector2d(0.2, 0.2);
+  EXPECT_THROW(Hmm::train(with_constant(a), wrong), ModelError);
+}
+
 TEST(Hmm, LongSequencesDoNotUnderflowAndStreamingMatches) {
   const Hmm h = three_states();
   std::mt19937_64 rng(2);

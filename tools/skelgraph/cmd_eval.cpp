@@ -4,7 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cctype>
+#include <cerrno>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <deque>
 #include <filesystem>
 #include <fstream>
@@ -471,7 +475,8 @@ int eval_live(const LiveOptions& o, GlobalOptions& g) {
   std::string dir = o.dir;
   if (dir.empty()) {
     std::string t = (std::filesystem::temp_directory_path() / "skelgraph-eval-live-XXXXXX").string();
-    if (mkdtemp(t.data()) == nullptr) throw std::runtime_error("cannot make a directory under " + t);
+    if (mkdtemp(t.data()) == nullptr)
+      throw std::runtime_error("cannot make a directory " + t + ": " + std::strerror(errno) + " (give one with --dir)");
     dir = t;
   }
   runtime::ResolvedComponent rec;
@@ -497,7 +502,14 @@ int eval_live(const LiveOptions& o, GlobalOptions& g) {
   std::fprintf(stderr, "scoring %s\n", file.c_str());
   FileOptions f = o.score;
   f.file = file;
-  return eval_file(f);
+  try {
+    return eval_file(f);
+  } catch (const UsageError& e) {
+    // Most likely nothing (or no poses) came while it recorded: say where it listened.
+    throw UsageError(std::string(e.what()) + " (recorded on domain " + std::to_string(config.domain) + ", profile " +
+                     config.profile + ", for " + std::to_string(static_cast<int>(o.duration)) +
+                     " s: is the cell running there?)");
+  }
 }
 
 // skelgraph fuse IN --out OUT: the recording with fused skeletons added on

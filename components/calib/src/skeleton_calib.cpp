@@ -338,6 +338,9 @@ LowestMedian lowest_median_pose(const std::vector<TimedSkeleton>& reference, con
   LowestMedian out;
   V6 best = V6::Zero();
   double best_f = out.start_median_m = cost(best);
+  out.reference_from_other = start;
+  out.median_m = best_f;
+  if (!std::isfinite(best_f)) return out;  // nothing matched at the start: nothing to search on
   // Steps: 2 degrees and 5 cm, then a third and a ninth of that.
   for (double scale : {1.0, 1.0 / 3, 1.0 / 9}) {
     std::array<V6, 7> x;
@@ -352,7 +355,7 @@ LowestMedian lowest_median_pose(const std::vector<TimedSkeleton>& reference, con
       std::array<double, 7> fs;
       for (std::size_t i = 0; i < 7; ++i) xs[i] = x[ord[i]], fs[i] = f[ord[i]];
       x = xs, f = fs;
-      if (f[6] - f[0] < 1e-6) break;  // a hundredth of a millimetre
+      if (f[6] - f[0] < 1e-6) break;  // a thousandth of a millimetre
       V6 c = V6::Zero();
       for (std::size_t i = 0; i < 6; ++i) c += x[i];
       c /= 6;

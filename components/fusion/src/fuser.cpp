@@ -218,6 +218,7 @@ struct Fuser::Impl {
   void update_heading(Track& tr, std::vector<View*>& vs, bool correct_flips) {
     std::vector<std::pair<View*, Vector3d>> claims;
     for (View* v : vs) {
+      if (v->occluded) continue;  // a ghost on an occluder says nothing about where the person faces
       if (auto f = claimed_heading(v->s)) claims.emplace_back(v, *f);
     }
     if (!tr.heading) {
@@ -318,12 +319,19 @@ struct Fuser::Impl {
       const double along = o.dot(ray);
       return along > 0.5 * kApart && (o - along * ray).norm() < along;  // within 45 degrees of the ray
     };
-    for (View* v : vs) {
-      for (const View* u : vs) {
-        if (u == v || u->sensor == v->sensor || u->occluded || !settled(*u) || !settled(*v) ||
-            (u->centre - v->centre).norm() < kApart)
-          continue;
-        if (behind(*v, *u) && !behind(*u, *v)) v->occluded = true;
+    // Two passes, so the answer does not depend on the views' order: a view
+    // is left out when a sensor that is not itself suspect vouches against it.
+    const auto against = [&](const View& v, const View& u) {
+      return &u != &v && u.sensor != v.sensor && settled(u) && settled(v) && (u.centre - v.centre).norm() >= kApart &&
+             behind(v, u) && !behind(u, v);
+    };
+    std::vector<bool> suspect(vs.size(), false);
+    for (std::size_t a = 0; a < vs.size(); ++a) {
+      for (std::size_t b = 0; b < vs.size(); ++b) suspect[a] = suspect[a] || against(*vs[a], *vs[b]);
+    }
+    for (std::size_t a = 0; a < vs.size(); ++a) {
+      for (std::size_t b = 0; b < vs.size(); ++b) {
+        if (!suspect[b] && against(*vs[a], *vs[b])) vs[a]->occluded = true;
       }
     }
     for (const View* v : vs) stats.occluded_views += v->occluded ? 1 : 0;
@@ -338,8 +346,7 @@ struct Fuser::Impl {
     return 0.03 * dist * view * conf;
   }
 
-  void fuse_kalman(Track& tr, std::vector<View*>& vs, std::int64_t t, skeleton::Skeleton& out) {
-    mark_occluded(vs, t);
+  void fuse_kalman(Track& tr, const std::vector<View*>& vs, std::int64_t t, skeleton::Skeleton& out) {
     const bool arbitrated = std::any_of(vs.begin(), vs.end(), [](const View* v) { return v->occluded; });
     for (std::size_t j = 0; j < kJointCount; ++j) {
       auto& f = tr.filters[j];
@@ -360,10 +367,20 @@ struct Fuser::Impl {
           agree = d * d <= kGate * (sa * sa + sb * sb);
         }
       }
+      // With a view left out, has the filter been following it (nearer to its
+      // joint than to every remaining sensor's)? Then the rest start it over
+      // at once; otherwise a remaining sensor's outlier is gated as usual.
+      bool followed_left_out = false;
+      if (arbitrated && f.initialised() && !meas.empty()) {
+        double nearest_kept = std::numeric_limits<double>::infinity();
+        for (const auto& [v, sg] : meas) nearest_kept = std::min(nearest_kept, (v->s.joints[j].position - f.position()).norm());
+        for (const View* v : vs) {
+          if (v->occluded && v->s.joints[j].confidence >= kInferred)
+            followed_left_out = followed_left_out || (v->s.joints[j].position - f.position()).norm() < nearest_kept;
+        }
+      }
       bool sensors_agree_against_filter = false;
-      // (or, with an occluded view left out, the filter followed that view: the rest start it over at once)
-      if (f.initialised() && (meas.size() >= 2 || (arbitrated && !meas.empty())) && tr.misses[j] < kResetAfterMisses &&
-          agree) {
+      if (f.initialised() && (meas.size() >= 2 || followed_left_out) && tr.misses[j] < kResetAfterMisses && agree) {
         bool all_gated = true;
         for (const auto& [v, sg] : meas) all_gated = all_gated && f.mahalanobis2(v->s.joints[j].position, sg) > kGate;
         sensors_agree_against_filter = all_gated;
@@ -456,6 +473,7 @@ struct Fuser::Impl {
     ++frame_number;
     for (auto& [id, vs] : by_track) {
       Track& tr = track_by_id(id);
+      if (opt.method == Method::Kalman) mark_occluded(vs, t);
       update_heading(tr, vs, opt.method == Method::Kalman);
       skeleton::Skeleton f;
       f.sensor_id = "fused";
@@ -518,7 +536,9 @@ void Fuser::add(const skeleton::Skeleton& raw, std::int64_t t_ns) {
   for (auto& j : s.world.joints) j.position = sensor.pose * j.position;
   s.world.frame_id = "world";
   auto& st = impl_->streams[{i, raw.person_id}];
-  if (st.samples.empty()) st.first_ns = t_ns;
+  // A stream that is new, or back after a gap (a tracker that lost and found
+  // the person under the same id), is settling from this sample on.
+  if (st.samples.empty() || t_ns - st.samples.back().t > impl_->opt.max_age_ns) st.first_ns = t_ns;
   st.sensor = i;
   // Samples arrive in time order from one sensor; keep a few for interpolation.
   auto pos = std::upper_bound(st.samples.begin(), st.samples.end(), t_ns,

@@ -455,11 +455,18 @@ Hmm Hmm::train(const std::vector<Sequence>& data, const TrainOptions& o, TrainRe
   for (const auto& x : data) var += (x.rowwise() - mean.transpose()).array().square().colwise().sum().matrix().transpose();
   var /= static_cast<double>(frames);
   // A feature that never varies in training (a joint a recording lacks,
-  // filled with a constant) has no spread of its own to scale by: it takes the
+  // filled with a constant) has no spread of its own to scale by: it takes
+  // the one given (a classifier's, shared by its models) or else the
   // features' mean spread, so that a test frame off by a hair in it is not
   // worth -1e12 (with 1e-12 it was; any feature with some spread is unchanged).
+  if (o.constant_spread.size() != 0 && o.constant_spread.size() != D)
+    throw ModelError("constant_spread has " + std::to_string(o.constant_spread.size()) + " values for " +
+                     std::to_string(D) + "-dimensional data");
   const double typical = var.mean() > 1e-12 ? var.mean() : 1.0;
-  const VectorXd spread = var.unaryExpr([&](double v) { return v > 1e-12 ? v : typical; });
+  VectorXd spread = var;
+  for (Eigen::Index d = 0; d < D; ++d) {
+    if (spread(d) <= 1e-12) spread(d) = o.constant_spread.size() == D && o.constant_spread(d) > 1e-12 ? o.constant_spread(d) : typical;
+  }
   const VectorXd reg = o.regularisation * spread;
   const MatrixXd global_cov = MatrixXd(spread.asDiagonal());
 

@@ -47,7 +47,12 @@ ViewerComponent::ViewerComponent(runtime::Context& ctx, const runtime::Params& p
       play_pub_(ctx, runtime::topics::kPlayControl),
       raw_sub_(ctx, runtime::topics::kSkeletonRaw, [this](const msg::Skeleton& m, const runtime::SampleMeta&) { on_skeleton(m, now()); }),
       fused_sub_(ctx, runtime::topics::kSkeletonFused, [this](const msg::Skeleton& m, const runtime::SampleMeta&) { on_skeleton(m, now()); }),
-      truth_sub_(ctx, runtime::topics::kSkeletonTruth, [this](const msg::Skeleton& m, const runtime::SampleMeta&) { on_skeleton(m, now()); }),
+      // The viewer draws the newest truth only. (Reliable, this was the stream
+      // missing from the page in 3 clean-clone test runs, stops 20, 24 and 27:
+      // nothing received in-process for the whole run while another process
+      // read it; the cause in Fast DDS 2.9 was not found.)
+      truth_sub_(ctx, runtime::topics::kSkeletonTruth, runtime::newest_only(runtime::topics::kSkeletonTruth.qos),
+                 [this](const msg::Skeleton& m, const runtime::SampleMeta&) { on_skeleton(m, now()); }),
       pose_sub_(ctx, runtime::topics::kCalibration,
                 [this](const msg::SensorPose& m, const runtime::SampleMeta&) {
                   if (!scene_.on_pose(skeleton::from_msg(m)))

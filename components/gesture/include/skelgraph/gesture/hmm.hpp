@@ -60,6 +60,11 @@ struct TrainOptions {
   int max_iterations = 100;
   double tolerance = 1e-4;      // stop when the mean log-likelihood per frame improves less than this
   double regularisation = 1e-3;  // added to covariance diagonals, times each dimension's variance over all data
+  // The spread a dimension that never varies in this model's data takes
+  // instead (regularisation and initial covariance). Empty: the mean over the
+  // model's other dimensions. Models whose scores are compared (a classifier's)
+  // should share one, so a feature constant everywhere shifts none against another.
+  Eigen::VectorXd constant_spread;
   std::uint64_t seed = 1;
 };
 

@@ -95,8 +95,10 @@ template <class T>
 class Subscription {
  public:
   using Callback = std::function<void(const T&, const SampleMeta&)>;
-  Subscription(Context& ctx, const TopicDef<T>& topic, Callback cb)
-      : base_(ctx, topic.name, make_type_support<T>(), topic.qos,
+  Subscription(Context& ctx, const TopicDef<T>& topic, Callback cb) : Subscription(ctx, topic, topic.qos, std::move(cb)) {}
+  // With another QoS than the topic's: e.g. newest_only() for a display.
+  Subscription(Context& ctx, const TopicDef<T>& topic, const QosPreset& qos, Callback cb)
+      : base_(ctx, topic.name, make_type_support<T>(), qos,
               [cb = std::move(cb)](void* s, const SampleMeta& m) { cb(*static_cast<const T*>(s), m); }) {}
   std::size_t matched() const { return base_.matched(); }
   bool wait_for_matched(std::size_t n, std::chrono::milliseconds timeout) const {

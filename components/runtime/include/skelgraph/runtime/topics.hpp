@@ -17,6 +17,14 @@ struct QosPreset {
   int depth = 0;  // history depth per instance; 0 = keep all
 };
 
+// A reader that only shows the newest samples (a display) asks for best
+// effort on any topic: a reliable writer serves it as well, and nothing is
+// repaired or queued for it.
+inline QosPreset newest_only(QosPreset q) {
+  q.reliability = Reliability::BestEffort;
+  return q;
+}
+
 // A topic bound to its wire type at compile time.
 template <class T>
 struct TopicDef {
