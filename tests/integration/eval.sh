@@ -38,6 +38,22 @@ for m in ("avg", "sum"):
 best = min(s["sensor1"]["mean_error_cm"], s["sensor2"]["mean_error_cm"])
 assert s["kalman"]["mean_error_cm"] < 0.75 * best, (s["kalman"]["mean_error_cm"], best)
 html = open(os.path.join(rep, "report.html")).read()
+# Every table row complete: 17 cells (stream, 6 groups x 2, 4 summary figures), none cut short.
+from html.parser import HTMLParser
+class Rows(HTMLParser):
+    def __init__(self):
+        super().__init__(); self.rows, self.cells, self.open = [], 0, False
+    def handle_starttag(self, tag, attrs):
+        if tag == "tr":
+            assert not self.open, "a <tr> inside an unclosed row"
+            self.open, self.cells = True, 0
+        elif tag in ("td", "th"):
+            self.cells += 1
+    def handle_endtag(self, tag):
+        if tag == "tr":
+            self.rows.append(self.cells); self.open = False
+rows = Rows(); rows.feed(html)
+assert rows.rows and all(n == 17 for n in rows.rows) and not rows.open, rows.rows
 # 16 figures per scenario: mean error, each group's error (6), right hand x/y/z,
 # each group's detection timeline (6)
 assert html.count("<svg") == 32 and "<table>" in html, html.count("<svg")

@@ -124,16 +124,15 @@ std::string report_section(const std::string& dir, const std::string& name, cons
   for (const auto* g : eval::group_names()) h << "<th>" << g << " det %</th><th>" << g << " err cm</th>";
   h << "<th>mean err cm</th><th>offsets removed cm</th><th>upper body %</th><th>bone SD cm</th></tr>\n";
   for (const auto& s : r.streams) {
+    // (Cells built as strings: a fixed buffer once cut the row's end off when figures had more digits.)
+    const auto td = [](double v, int decimals) {
+      const std::string n = csv_num(v, decimals);
+      return "<td>" + (n.empty() ? std::string("-") : n) + "</td>";
+    };
     h << "<tr><td>" << report::html_escape(s.name) << "</td>";
-    char b[64];
-    for (const auto& g : s.accuracy.figures()) {
-      std::snprintf(b, sizeof b, "<td>%.1f</td><td>%.1f</td>", g.detection_pct, g.error_cm);
-      h << b;
-    }
-    std::snprintf(b, sizeof b, "<td><b>%.1f</b></td><td>%.1f</td><td>%.1f</td><td>%.2f</td></tr>\n",
-                  s.accuracy.mean_error_cm(), s.compensated.mean_error_cm(), s.steadiness.upper_body_complete_pct(),
-                  s.steadiness.mean_bone_sd_cm());
-    h << b;
+    for (const auto& g : s.accuracy.figures()) h << td(g.detection_pct, 1) << td(g.error_cm, 1);
+    h << "<td><b>" << csv_num(s.accuracy.mean_error_cm(), 1) << "</b></td>" << td(s.compensated.mean_error_cm(), 1)
+      << td(s.steadiness.upper_body_complete_pct(), 1) << td(s.steadiness.mean_bone_sd_cm(), 2) << "</tr>\n";
   }
   h << "</table>\n";
   write_text_file(std::filesystem::path(dir) / (name + ".csv"), csv_header() + csv_rows(name, r));
