@@ -45,6 +45,19 @@ std::string html_escape(const std::string& s) {
   return o;
 }
 
+namespace {
+// The figure's title from the left edge; one too long for the figure is
+// squeezed to its width rather than cut off at the edge.
+std::string title_text(const std::string& title, int width) {
+  const double room = width - 16, guess = 7.3 * static_cast<double>(title.size());  // bold 13 px sans-serif
+  std::ostringstream o;
+  o << "<text x=\"8\" y=\"16\" font-size=\"13\" font-weight=\"bold\"";
+  if (guess > room) o << " textLength=\"" << room << "\" lengthAdjust=\"spacingAndGlyphs\"";
+  o << ">" << html_escape(title) << "</text>\n";
+  return o.str();
+}
+}  // namespace
+
 std::string line_plot(const std::string& title, const std::string& x_label, const std::string& y_label,
                       const std::vector<Series>& series, int width, int height) {
   const int left = 56, right = 150, top = 28, bottom = 40;
@@ -71,7 +84,7 @@ std::string line_plot(const std::string& title, const std::string& x_label, cons
   o << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << height
     << "\" font-family=\"sans-serif\" font-size=\"11\">\n"
     << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
-    << "<text x=\"" << left << "\" y=\"16\" font-size=\"13\" font-weight=\"bold\">" << html_escape(title) << "</text>\n";
+    << title_text(title, width);
   for (double y = y0; y <= y1 + 1e-9; y += ystep) {
     o << "<line x1=\"" << left << "\" x2=\"" << left + pw << "\" y1=\"" << Y(y) << "\" y2=\"" << Y(y)
       << "\" stroke=\"#ddd\"/><text x=\"" << left - 4 << "\" y=\"" << Y(y) + 4 << "\" text-anchor=\"end\">" << fmt(y)
@@ -127,7 +140,7 @@ std::string timeline(const std::string& title, const std::vector<Strip>& strips,
   std::ostringstream o;
   o << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << height
     << "\" font-family=\"sans-serif\" font-size=\"11\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
-    << "<text x=\"" << left << "\" y=\"16\" font-size=\"13\" font-weight=\"bold\">" << html_escape(title) << "</text>\n";
+    << title_text(title, width);
   for (std::size_t k = 0; k < strips.size(); ++k) {
     const auto& s = strips[k];
     const double y = top + row * static_cast<double>(k);
