@@ -49,12 +49,14 @@ Section pointing_section() {
       const SpottedEvent* hit = nullptr;
       for (const auto& e : spotted[n].events)
         if (e.end_ns >= g.start_ns - 500'000'000 && e.end_ns <= g.end_ns + 500'000'000) hit = &e;
-      char buf[400];
+      char sent[32] = "missed", where[64] = "-", error[32] = "-", buf[400];
+      if (hit) std::snprintf(sent, sizeof sent, "%.0f ms", 1e3 * static_cast<double>(hit->end_ns - g.hold_ns) * 1e-9);
+      if (hit && hit->has_target) {
+        std::snprintf(where, sizeof where, "(%.2f, %.2f)", hit->target.x(), hit->target.z());
+        std::snprintf(error, sizeof error, "%.1f cm", 100 * (hit->target - g.target).norm());
+      }
       std::snprintf(buf, sizeof buf, "<tr><td>%zu</td><td>%.1f</td><td>(%.2f, %.2f)</td><td>%s</td><td>%s</td><td>%s</td></tr>\n",
-                    n + 1, static_cast<double>(g.start_ns) * 1e-9, g.target.x(), g.target.z(),
-                    hit ? (std::to_string(static_cast<int>(std::lround(1e3 * static_cast<double>(hit->end_ns - g.hold_ns) * 1e-9))) + " ms").c_str() : "missed",
-                    hit && hit->has_target ? ("(" + std::to_string(hit->target.x()).substr(0, 5) + ", " + std::to_string(hit->target.z()).substr(0, 5) + ")").c_str() : "-",
-                    hit && hit->has_target ? (std::to_string(100 * (hit->target - g.target).norm()).substr(0, 4) + " cm").c_str() : "-");
+                    n + 1, static_cast<double>(g.start_ns) * 1e-9, g.target.x(), g.target.z(), sent, where, error);
       rows += buf;
     }
   }
