@@ -398,31 +398,9 @@ int merge(const std::vector<std::string>& files, const std::string& out_path, mc
 }  // namespace
 
 // Runs one component of `kind` with parameters given as text.
-struct ComponentRun {
-  std::string name, kind;
-  std::vector<runtime::RawParam> raw;
-};
-
-int run_components(GlobalOptions& g, const std::vector<ComponentRun>& list, const RunOptions& ro) {
-  const auto registry = runtime::builtin_registry();
-  std::vector<runtime::ResolvedComponent> graph;
-  for (const auto& r : list) {
-    runtime::ResolvedComponent c;
-    c.name = r.name;
-    c.kind = r.kind;
-    try {
-      c.params = registry.find(r.kind)->info.params.resolve(r.raw, "component '" + r.name + "'");
-    } catch (const runtime::ParamError& e) {
-      throw UsageError(e.what());
-    }
-    graph.push_back(std::move(c));
-  }
-  return user_input([&] { return run_graph(registry, make_config(g), graph, ro, nullptr); });
-}
-
 int run_component(GlobalOptions& g, const std::string& kind, const std::vector<runtime::RawParam>& raw,
                   const RunOptions& ro) {
-  return run_components(g, {{kind, kind, raw}}, ro);
+  return user_input([&] { return run_components(g, {{kind, kind, raw}}, ro); });
 }
 
 void add_bag_command(CLI::App& app, GlobalOptions& g, Action& run) {
@@ -505,16 +483,15 @@ void add_bag_command(CLI::App& app, GlobalOptions& g, Action& run) {
   view->callback([o, v, r, &g, &run] {
     run = [o, v, r, &g] {
       const auto b = [](bool x) { return std::string(x ? "true" : "false"); };
-      return run_components(g,
-                            {{"player", "bag_player",
-                              {{"file", o->file, "view"},
-                               {"rate", std::to_string(v->rate), "view"},
-                               {"paused", b(v->paused), "view"},
-                               {"loop", b(v->loop), "view"},
-                               {"hold_at_end", "true", "view"}}},
-                             {"viewer", "viewer",
-                              {{"address", v->address, "view"}, {"port", std::to_string(v->port), "view"}}}},
-                            r->run);
+      const std::vector<ComponentRun> list{
+          {"player", "bag_player",
+           {{"file", o->file, "view"},
+            {"rate", std::to_string(v->rate), "view"},
+            {"paused", b(v->paused), "view"},
+            {"loop", b(v->loop), "view"},
+            {"hold_at_end", "true", "view"}}},
+          {"viewer", "viewer", {{"address", v->address, "view"}, {"port", std::to_string(v->port), "view"}}}};
+      return user_input([&] { return run_components(g, list, r->run); });
     };
   });
 

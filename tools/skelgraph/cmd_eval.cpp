@@ -19,7 +19,6 @@
 #include <queue>
 #include <sstream>
 
-
 #include <nlohmann/json.hpp>
 
 #include "cli.hpp"
@@ -33,7 +32,6 @@
 #include "skelgraph/mcap/mcap.hpp"
 #include "skelgraph/msg/cdr.hpp"
 #include "skelgraph/recording/bag.hpp"
-#include "skelgraph/runtime/registry.hpp"
 #include "skelgraph/runtime/topics.hpp"
 #include "skelgraph/skeleton/skeleton_msg.hpp"
 #include "skelgraph/sim/sim_component.hpp"
@@ -347,7 +345,7 @@ void stream_recording(const RecordingInputs& in, eval::Evaluator& ev, const Mess
   std::priority_queue<Held, std::vector<Held>, decltype(later)> held(later);
   std::uint64_t seq = 0;
   std::int64_t latest = std::numeric_limits<std::int64_t>::min();
-  // Progress on a terminal, for recordings that take a while (over ~10 minutes of two sensors).
+  // Progress for recordings that take a while (over ~10 minutes of two sensors).
   const std::uint64_t total = in.raw + in.truth + in.fused;
   Progress progress(total > 40'000);
   try {
@@ -470,7 +468,6 @@ struct LiveOptions {
 };
 
 int eval_live(const LiveOptions& o, GlobalOptions& g) {
-  const auto registry = runtime::builtin_registry();
   std::string dir = o.dir;
   if (dir.empty()) {
     std::string t = (std::filesystem::temp_directory_path() / "skelgraph-eval-live-XXXXXX").string();
@@ -478,24 +475,17 @@ int eval_live(const LiveOptions& o, GlobalOptions& g) {
       throw std::runtime_error("cannot make a directory " + t + ": " + std::strerror(errno) + " (give one with --dir)");
     dir = t;
   }
-  runtime::ResolvedComponent rec;
-  rec.name = "eval_recorder";
-  rec.kind = "recorder";
-  try {
-    rec.params = registry.find("recorder")->info.params.resolve(
-        {{"directory", dir, "eval live --dir"}, {"now", "true", "eval live"}, {"label", "eval_live", "eval live"}},
-        "eval live");
-  } catch (const runtime::ParamError& e) {
-    throw UsageError(e.what());
-  }
   const auto config = make_config(g);
   std::fprintf(stderr, "recording the skeleton topics on domain %d (profile %s) for %.0f s into %s (Ctrl-C ends it sooner)\n",
                config.domain, config.profile.c_str(), o.duration, dir.c_str());
   RunOptions ro;
   ro.duration_s = o.duration;
   std::string file;
-  const int rc = run_graph(registry, config, {rec}, ro,
-                           [&](runtime::Graph& graph, nlohmann::json&) { file = recorded_file(graph); });
+  const int rc = run_components(
+      g,
+      {{"eval_recorder", "recorder",
+        {{"directory", dir, "eval live --dir"}, {"now", "true", "eval live"}, {"label", "eval_live", "eval live"}}}},
+      ro, [&](runtime::Graph& graph, nlohmann::json&) { file = recorded_file(graph); });
   if (rc != 0) return rc;
   if (file.empty()) throw std::runtime_error("the recorder wrote no file into " + dir);
   std::fprintf(stderr, "scoring %s\n", file.c_str());

@@ -6,6 +6,7 @@
 #include <spdlog/spdlog.h>
 
 #include "cli.hpp"
+#include "skelgraph/runtime/registry.hpp"
 
 namespace skelgraph::cli {
 
@@ -25,6 +26,24 @@ void add_run_options(CLI::App& cmd, RunOptions& options) {
   cmd.add_option("--status-every", options.status_every_s, "print each component's status line every S seconds")
       ->check(kNonNegative);
   cmd.add_flag("--json", options.json, "print the final report as JSON on stdout");
+}
+
+int run_components(GlobalOptions& g, const std::vector<ComponentRun>& list, const RunOptions& options,
+                   const std::function<void(runtime::Graph&, nlohmann::json&)>& extra_report) {
+  const auto registry = runtime::builtin_registry();
+  std::vector<runtime::ResolvedComponent> graph;
+  for (const auto& r : list) {
+    runtime::ResolvedComponent c;
+    c.name = r.name;
+    c.kind = r.kind;
+    try {
+      c.params = registry.find(r.kind)->info.params.resolve(r.raw, "component '" + r.name + "'");
+    } catch (const runtime::ParamError& e) {
+      throw UsageError(e.what());
+    }
+    graph.push_back(std::move(c));
+  }
+  return run_graph(registry, make_config(g), graph, options, extra_report);
 }
 
 std::string recorded_file(const runtime::Graph& graph) {

@@ -32,6 +32,17 @@ int run_graph(const runtime::ComponentRegistry& registry, const runtime::DdsConf
               const std::vector<runtime::ResolvedComponent>& components, const RunOptions& options,
               const std::function<void(runtime::Graph&, nlohmann::json&)>& extra_report);
 
+// Components given by type and parameters as text (like `skelgraph run`):
+// resolved against the built-in registry (bad parameters are a UsageError)
+// and run with run_graph on the command line's DDS settings.
+struct ComponentRun {
+  std::string name, kind;
+  std::vector<runtime::RawParam> raw;
+};
+struct GlobalOptions;
+int run_components(GlobalOptions& g, const std::vector<ComponentRun>& list, const RunOptions& options,
+                   const std::function<void(runtime::Graph&, nlohmann::json&)>& extra_report = nullptr);
+
 // The first recording a recorder component of the graph wrote, if any.
 std::string recorded_file(const runtime::Graph& graph);
 

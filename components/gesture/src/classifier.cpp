@@ -92,26 +92,10 @@ Models train_models(const std::vector<const Clip*>& clips, const ClassMap& map, 
   // every model: their spread over all the training clips (or, constant
   // everywhere, the features' mean), so such a feature shifts no model's
   // score against another's.
-  Eigen::VectorXd shared_spread;
-  {
-    const auto dim = data.front()->front().cols();
-    Eigen::VectorXd mean = Eigen::VectorXd::Zero(dim);
-    double n = 0;
-    for (const auto* seqs : data)
-      for (const auto& x : *seqs) mean += x.colwise().sum().transpose(), n += static_cast<double>(x.rows());
-    mean /= n;
-    shared_spread = Eigen::VectorXd::Zero(dim);
-    for (const auto* seqs : data)
-      for (const auto& x : *seqs) shared_spread += (x.rowwise() - mean.transpose()).array().square().colwise().sum().matrix().transpose();
-    shared_spread /= n;
-    double typical = 0;
-    int varied = 0;
-    for (Eigen::Index d = 0; d < dim; ++d)
-      if (shared_spread(d) > 1e-12) typical += shared_spread(d), ++varied;
-    typical = varied > 0 ? typical / varied : 1.0;
-    for (Eigen::Index d = 0; d < dim; ++d)
-      if (shared_spread(d) <= 1e-12) shared_spread(d) = typical;
-  }
+  std::vector<const Sequence*> every_clip;
+  for (const auto* seqs : data)
+    for (const auto& x : *seqs) every_clip.push_back(&x);
+  const Eigen::VectorXd shared_spread = feature_spread(every_clip);
   m.hmms.resize(data.size());
   parallel_for(static_cast<int>(data.size()), o.threads, [&](int i) {
     const auto iu = static_cast<std::size_t>(i);

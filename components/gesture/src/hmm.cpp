@@ -418,6 +418,26 @@ MatrixXd shape(const MatrixXd& cov, Covariance c, const VectorXd& reg) {
 
 }  // namespace
 
+VectorXd feature_spread(const std::vector<const Sequence*>& data, const VectorXd& constant, VectorXd* mean_out) {
+  if (data.empty()) throw ModelError("feature_spread: no sequences");
+  const auto D = data.front()->cols();
+  VectorXd mean = VectorXd::Zero(D), var = VectorXd::Zero(D);
+  double frames = 0;
+  for (const auto* x : data) mean += x->colwise().sum().transpose(), frames += static_cast<double>(x->rows());
+  mean /= frames;
+  for (const auto* x : data) var += (x->rowwise() - mean.transpose()).array().square().colwise().sum().matrix().transpose();
+  var /= frames;
+  double typical = 0;
+  int varied = 0;
+  for (Eigen::Index d = 0; d < D; ++d)
+    if (var(d) > 1e-12) typical += var(d), ++varied;
+  typical = varied > 0 ? typical / varied : 1.0;
+  for (Eigen::Index d = 0; d < D; ++d)
+    if (var(d) <= 1e-12) var(d) = constant.size() == D && constant(d) > 1e-12 ? constant(d) : typical;
+  if (mean_out) *mean_out = mean;
+  return var;
+}
+
 Hmm Hmm::train(const std::vector<Sequence>& data, const TrainOptions& o, TrainReport* report) {
   if (data.empty()) throw ModelError("training: no sequences");
   if (o.states < 1 || o.mixtures < 1 || o.restarts < 1) throw ModelError("training: states, mixtures and restarts must be >= 1");
@@ -448,25 +468,17 @@ Hmm Hmm::train(const std::vector<Sequence>& data, const TrainOptions& o, TrainRe
     return best;
   }
   const int N = o.states, M = o.mixtures;
-  // Regularisation scaled to each feature's spread over all data.
-  VectorXd mean = VectorXd::Zero(D), var = VectorXd::Zero(D);
-  for (const auto& x : data) mean += x.colwise().sum().transpose();
-  mean /= static_cast<double>(frames);
-  for (const auto& x : data) var += (x.rowwise() - mean.transpose()).array().square().colwise().sum().matrix().transpose();
-  var /= static_cast<double>(frames);
-  // A feature that never varies in training (a joint a recording lacks,
-  // filled with a constant) has no spread of its own to scale by: it takes
-  // the one given (a classifier's, shared by its models) or else the
-  // features' mean spread, so that a test frame off by a hair in it is not
-  // worth -1e12 (with 1e-12 it was; any feature with some spread is unchanged).
+  // Regularisation scaled to each feature's spread over all data. A feature
+  // that never varies takes the spread given (a classifier's, shared by its
+  // models) or the others' mean, so that a test frame off by a hair in it is
+  // not worth -1e12 (with a floor of 1e-12 it was).
   if (o.constant_spread.size() != 0 && o.constant_spread.size() != D)
     throw ModelError("constant_spread has " + std::to_string(o.constant_spread.size()) + " values for " +
                      std::to_string(D) + "-dimensional data");
-  const double typical = var.mean() > 1e-12 ? var.mean() : 1.0;
-  VectorXd spread = var;
-  for (Eigen::Index d = 0; d < D; ++d) {
-    if (spread(d) <= 1e-12) spread(d) = o.constant_spread.size() == D && o.constant_spread(d) > 1e-12 ? o.constant_spread(d) : typical;
-  }
+  std::vector<const Sequence*> all_data;
+  for (const auto& x : data) all_data.push_back(&x);
+  VectorXd mean;
+  const VectorXd spread = feature_spread(all_data, o.constant_spread, &mean);
   const VectorXd reg = o.regularisation * spread;
   const MatrixXd global_cov = MatrixXd(spread.asDiagonal());
 

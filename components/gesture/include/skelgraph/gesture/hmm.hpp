@@ -68,6 +68,13 @@ struct TrainOptions {
   std::uint64_t seed = 1;
 };
 
+// Each feature's variance over every frame of `data` (the features' means in
+// `mean` if given). A feature that never varies (a joint a recording lacks,
+// filled with a constant) has no spread of its own: it gets `constant(d)` if
+// given, else the mean variance of the features that do vary (1 if none does).
+Eigen::VectorXd feature_spread(const std::vector<const Sequence*>& data, const Eigen::VectorXd& constant = {},
+                               Eigen::VectorXd* mean = nullptr);
+
 struct TrainReport {
   int iterations = 0;
   bool converged = false;
