@@ -6,28 +6,37 @@
 # event's floor target against where the true shoulder -> hand ray of the
 # same arm met the floor while that arm was held still near the event's
 # stamp. JSON on stdout: per event the error, and the median. Needs root for
-# `unshare -n`.
-# Usage: bench/gesture_live.sh BUILD_DIR [SECONDS]
+# `unshare -n`. NOISE_SCALE (default 1) scales the simulated trackers' random
+# errors (the sim's noise_scale; 0 leaves the skeleton convention's offsets,
+# the lag and the geometry): how far the targets are off without that noise.
+# Usage: bench/gesture_live.sh BUILD_DIR [SECONDS] [NOISE_SCALE]
 set -euo pipefail
-build=${1:?usage: gesture_live.sh BUILD_DIR [SECONDS]}
+build=${1:?usage: gesture_live.sh BUILD_DIR [SECONDS] [NOISE_SCALE]}
 seconds=${2:-60}
+noise=${3:-1}
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 sg="$build/bin/skelgraph"
+launch="$root/bringup/gesture_sim.yaml"
+if [[ "$noise" != 1 ]]; then
+  launch="$work/gesture_sim.yaml"
+  sed "s/^      loop: true\$/      loop: true\n      noise_scale: $noise/" "$root/bringup/gesture_sim.yaml" >"$launch"
+  grep -q "noise_scale: $noise" "$launch" || { echo "gesture_live.sh: could not set noise_scale in $launch" >&2; exit 2; }
+fi
 unshare -n bash -c '
   set -e
   ip link set lo up
   cd "$1"
   "$2" topic echo skelgraph/skeleton/truth --json --timeout 120 >"$3/truth.json" & tp=$!
   "$2" topic echo skelgraph/gesture/event --json --timeout 120 >"$3/events.json" & ep=$!
-  "$2" launch bringup/gesture_sim.yaml --duration "$4" >"$3/launch.json" 2>"$3/launch.err"
+  "$2" launch "$5" --duration "$4" >"$3/launch.json" 2>"$3/launch.err"
   sleep 1
   kill $tp $ep 2>/dev/null || true
-' _ "$root" "$sg" "$work" "$seconds"
-python3 - "$work" "$seconds" <<'PY'
+' _ "$root" "$sg" "$work" "$seconds" "$launch"
+python3 - "$work" "$seconds" "$noise" <<'PY'
 import bisect, json, math, statistics, sys
-work, seconds = sys.argv[1], float(sys.argv[2])
+work, seconds, noise = sys.argv[1], float(sys.argv[2]), float(sys.argv[3])
 truth = [json.loads(l)["data"] for l in open(work + "/truth.json") if l.strip()]
 events = [json.loads(l)["data"] for l in open(work + "/events.json") if l.strip()]
 stamps = [t["stamp_ns"] for t in truth]
@@ -70,7 +79,7 @@ for e in events:
             row.update(true_target=tt, target=[e["target"][c] for c in "xyz"], error_m=err, held_frames=len(hits))
             errors.append(err)
     out.append(row)
-print(json.dumps({"seconds": seconds, "events": len(events), "scored": len(errors),
+print(json.dumps({"seconds": seconds, "noise_scale": noise, "events": len(events), "scored": len(errors),
                   "median_target_error_m": statistics.median(errors) if errors else None,
                   "within_15_cm": sum(e <= 0.15 for e in errors), "per_event": out}, indent=2))
 PY

@@ -61,6 +61,20 @@ ok "live: gesture states read over DDS, 'holding' during each pointing event"
 json_check "$WORK/sim.json" 'd["spotting"]["truth"] == 12 and d["spotting"]["recall"] >= 0.8 and d["spotting"]["median_target_error_m"] < 0.4'
 ok "offline: held-out simulated sessions scored"
 
+# The same sessions without the trackers' random errors: the targets land
+# within a few centimetres (what is left at noise 1 is the trackers' noise).
+"$S" gesture sim --train-sessions 4 --test-sessions 2 --test-noise-scale 0 --json >"$WORK/sim0.json" 2>/dev/null || fail "gesture sim --test-noise-scale 0"
+python3 - "$WORK/sim.json" "$WORK/sim0.json" <<'PY' || fail "noise-free test sessions"
+import json, sys
+a, b = (json.load(open(f)) for f in sys.argv[1:])
+assert b["test_noise_scale"] == 0 and a["test_noise_scale"] == 1, (a["test_noise_scale"], b["test_noise_scale"])
+s0, s1 = b["spotting"], a["spotting"]
+assert s0["truth"] == 12 and s0["recall"] >= 0.8, s0
+assert s0["median_target_error_m"] < 0.08 and s0["median_target_error_m"] < s1["median_target_error_m"], (s0["median_target_error_m"], s1["median_target_error_m"])
+print("median target error, noise 1 -> 0: %.1f -> %.1f cm" % (100 * s1["median_target_error_m"], 100 * s0["median_target_error_m"]))
+PY
+ok "offline: without the trackers' noise the targets are within a few cm"
+
 # Parameters from the command line: surfaces as a comma-split list, and clear errors.
 "$S" run gesture -p model=sim -p surfaces=table:0,0.75,0,floor:0,0,0 --duration 0.5 >/dev/null 2>"$WORK/run.err" \
   || fail "run gesture with two surfaces: $(tail -3 "$WORK/run.err")"

@@ -11,10 +11,11 @@ namespace skelgraph::gesture {
 using Eigen::Vector3d;
 using skeleton::JointId;
 
-SimSession simulate_session(std::uint64_t seed, const Surface& floor) {
+SimSession simulate_session(std::uint64_t seed, const Surface& floor, double noise_scale) {
   sim::SimConfig cfg;
   cfg.scenario.name = "point";
   cfg.scenario.seed = seed;
+  cfg.noise_scale = noise_scale;
   sim::Simulation simulation(cfg);
   std::map<std::string, Eigen::Isometry3d> poses;
   for (const auto& s : cfg.sensors) poses[s.id] = s.world_from_sensor();
@@ -131,6 +132,37 @@ void learn_joint_offsets(const std::vector<SimSession>& sessions, PointingCorrec
   }
 }
 
+std::vector<double> whole_hold_target_errors(const std::vector<SimSession>& sessions, const PointingCorrection& c,
+                                             const Surface& floor) {
+  std::vector<double> out;
+  for (const auto& s : sessions)
+    for (const auto& g : s.truth) {
+      if (g.label != "point" || !g.has_target) continue;
+      Vector3d sh = Vector3d::Zero(), ha = Vector3d::Zero(), o = Vector3d::Zero();
+      int n = 0;
+      for (const auto& h : s.holds) {
+        if (h.truth.stamp_ns < g.start_ns || h.truth.stamp_ns > g.end_ns) continue;
+        const JointId sj = h.right ? JointId::RightShoulder : JointId::LeftShoulder;
+        const JointId hj = h.right ? JointId::RightHand : JointId::LeftHand;
+        const auto& l = h.fused[JointId::LeftShoulder];
+        const auto& r = h.fused[JointId::RightShoulder];
+        if (l.confidence < skeleton::kTracked || r.confidence < skeleton::kTracked || h.fused[sj].confidence < skeleton::kTracked ||
+            h.fused[hj].confidence < skeleton::kTracked)
+          continue;
+        const ArmFrame arm(r.position - l.position, h.right);
+        sh += h.fused[sj].position - arm.to_world(c.shoulder);
+        ha += h.fused[hj].position - arm.to_world(c.hand);
+        o += arm.out;
+        ++n;
+      }
+      if (n == 0) continue;
+      const Vector3d origin = sh / n;
+      if (const auto hit = intersect(origin, corrected((ha - sh).normalized(), o.normalized(), c), floor))
+        out.push_back((*hit - g.target).norm());
+    }
+  return out;
+}
+
 ClassMap sim_class_map() {
   ClassMap m;
   m.classes = {"point", "other"};
@@ -168,10 +200,11 @@ std::vector<Clip> session_clips(const std::vector<SimSession>& sessions, const C
 
 namespace skelgraph::gesture {
 
-std::vector<SimSession> held_out_sessions(int sessions, std::uint64_t seed, const std::function<void(int, int)>& progress) {
+std::vector<SimSession> held_out_sessions(int sessions, std::uint64_t seed, const std::function<void(int, int)>& progress,
+                                          double noise_scale) {
   std::vector<SimSession> out;
   for (int i = 0; i < sessions; ++i) {
-    out.push_back(simulate_session((seed + 1) * 1000 + 500 + static_cast<std::uint64_t>(i)));
+    out.push_back(simulate_session((seed + 1) * 1000 + 500 + static_cast<std::uint64_t>(i), {}, noise_scale));
     if (progress) progress(i + 1, sessions);
   }
   return out;

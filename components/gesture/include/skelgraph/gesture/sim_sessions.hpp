@@ -32,8 +32,16 @@ struct SimSession {
 // true ones over the sessions' holds.
 void learn_joint_offsets(const std::vector<SimSession>& sessions, PointingCorrection& c);
 
-// One session of the point scenario with this seed (people = 1, the default two sensors).
-SimSession simulate_session(std::uint64_t seed, const Surface& floor = {});
+// A reference for the spotter's targets: for each true pointing hold, the
+// fused shoulder and hand averaged over the whole hold as the truth times it
+// (no spotter could know its bounds better), corrected by `c` as the spotter
+// corrects them, and where that ray meets `floor` against the true target (m).
+std::vector<double> whole_hold_target_errors(const std::vector<SimSession>& sessions, const PointingCorrection& c,
+                                             const Surface& floor = {});
+
+// One session of the point scenario with this seed (people = 1, the default
+// two sensors). noise_scale scales the trackers' random errors (sim::SimConfig).
+SimSession simulate_session(std::uint64_t seed, const Surface& floor = {}, double noise_scale = 1.0);
 
 // Labelled clips cut from sessions: each true gesture (action point, wave or
 // stretch; from `pad` s before to `pad` s after) and one rest clip per rest
@@ -50,7 +58,8 @@ ClassifierOptions sim_classifier_options();
 
 // Sessions the training never sees (seeds (seed + 1) * 1000 + 500 + i).
 std::vector<SimSession> held_out_sessions(int sessions, std::uint64_t seed,
-                                          const std::function<void(int done, int total)>& progress = {});
+                                          const std::function<void(int done, int total)>& progress = {},
+                                          double noise_scale = 1.0);
 
 // Each session spotted (one Spotter per fused person) and scored against its own truth.
 struct SessionSpotting {
