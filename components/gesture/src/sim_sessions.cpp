@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <map>
+#include <optional>
 
 #include "skelgraph/eval/offline.hpp"
 #include "skelgraph/sim/simulation.hpp"
@@ -109,20 +110,34 @@ SimSession simulate_session(std::uint64_t seed, const Surface& floor, double noi
   return out;
 }
 
+namespace {
+
+// A hold frame's pointing arm, when the fused skeleton tracks both shoulders and that arm's hand.
+struct HoldArm {
+  JointId shoulder, hand;
+  ArmFrame frame;
+};
+std::optional<HoldArm> hold_arm(const SimSession::Hold& h) {
+  const JointId sh = h.right ? JointId::RightShoulder : JointId::LeftShoulder;
+  const JointId ha = h.right ? JointId::RightHand : JointId::LeftHand;
+  const auto& l = h.fused[JointId::LeftShoulder];
+  const auto& r = h.fused[JointId::RightShoulder];
+  if (l.confidence < skeleton::kTracked || r.confidence < skeleton::kTracked || h.fused[sh].confidence < skeleton::kTracked ||
+      h.fused[ha].confidence < skeleton::kTracked)
+    return std::nullopt;
+  return HoldArm{sh, ha, ArmFrame(r.position - l.position, h.right)};
+}
+
+}  // namespace
+
 void learn_joint_offsets(const std::vector<SimSession>& sessions, PointingCorrection& c) {
   std::vector<double> d[2][3];  // [shoulder, hand][out, up, forward]
   for (const auto& s : sessions)
     for (const auto& h : s.holds) {
-      const JointId sh = h.right ? JointId::RightShoulder : JointId::LeftShoulder;
-      const JointId ha = h.right ? JointId::RightHand : JointId::LeftHand;
-      const auto& l = h.fused[JointId::LeftShoulder];
-      const auto& r = h.fused[JointId::RightShoulder];
-      if (l.confidence < skeleton::kTracked || r.confidence < skeleton::kTracked || h.fused[sh].confidence < skeleton::kTracked ||
-          h.fused[ha].confidence < skeleton::kTracked)
-        continue;
-      const ArmFrame arm(r.position - l.position, h.right);
-      const Vector3d a = arm.to_body(h.fused[sh].position - h.truth[sh].position);
-      const Vector3d b = arm.to_body(h.fused[ha].position - h.truth[ha].position);
+      const auto arm = hold_arm(h);
+      if (!arm) continue;
+      const Vector3d a = arm->frame.to_body(h.fused[arm->shoulder].position - h.truth[arm->shoulder].position);
+      const Vector3d b = arm->frame.to_body(h.fused[arm->hand].position - h.truth[arm->hand].position);
       for (int k = 0; k < 3; ++k) d[0][k].push_back(a[k]), d[1][k].push_back(b[k]);
     }
   if (d[0][0].empty()) return;
@@ -142,17 +157,11 @@ std::vector<double> whole_hold_target_errors(const std::vector<SimSession>& sess
       int n = 0;
       for (const auto& h : s.holds) {
         if (h.truth.stamp_ns < g.start_ns || h.truth.stamp_ns > g.end_ns) continue;
-        const JointId sj = h.right ? JointId::RightShoulder : JointId::LeftShoulder;
-        const JointId hj = h.right ? JointId::RightHand : JointId::LeftHand;
-        const auto& l = h.fused[JointId::LeftShoulder];
-        const auto& r = h.fused[JointId::RightShoulder];
-        if (l.confidence < skeleton::kTracked || r.confidence < skeleton::kTracked || h.fused[sj].confidence < skeleton::kTracked ||
-            h.fused[hj].confidence < skeleton::kTracked)
-          continue;
-        const ArmFrame arm(r.position - l.position, h.right);
-        sh += h.fused[sj].position - arm.to_world(c.shoulder);
-        ha += h.fused[hj].position - arm.to_world(c.hand);
-        o += arm.out;
+        const auto arm = hold_arm(h);
+        if (!arm) continue;
+        sh += h.fused[arm->shoulder].position - arm->frame.to_world(c.shoulder);
+        ha += h.fused[arm->hand].position - arm->frame.to_world(c.hand);
+        o += arm->frame.out;
         ++n;
       }
       if (n == 0) continue;
