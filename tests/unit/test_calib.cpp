@@ -263,6 +263,28 @@ TEST(SkeletonCalib, TheLowestMedianPoseBeatsItsStartAndTheTruth) {
   EXPECT_LT(dist, 0.04);
 }
 
+// More starts (--best-rigid-starts): from a start 12 degrees and 34 cm off,
+// the searches end at or below the truth's median, never higher than the
+// one search from the same pose; no starts is a clear error.
+TEST(SkeletonCalib, MoreStartsOfTheLowestMedianSearchNeverEndHigher) {
+  const auto p = simulate("walk", 1, 20);
+  const auto at = [&](const Eigen::Isometry3d& x) { return calib::median(calib::joint_distances(p.ref, p.other, x)); };
+  Eigen::Isometry3d off = p.truth;
+  off.pretranslate(Vector3d(0.25, -0.1, 0.2));
+  off.prerotate(Eigen::AngleAxisd(12.0 * M_PI / 180.0, Vector3d(1, 1, 0).normalized()).toRotationMatrix());
+  const auto one = calib::lowest_median_pose(p.ref, p.other, off);
+  const auto many = calib::lowest_median_pose(p.ref, p.other, off, 0, {}, 1.0, 6);
+  EXPECT_EQ(one.starts, 1);
+  EXPECT_EQ(many.starts, 6);
+  EXPECT_DOUBLE_EQ(many.start_median_m, one.start_median_m);
+  EXPECT_LE(many.median_m, one.median_m);
+  EXPECT_DOUBLE_EQ(many.median_m, at(many.reference_from_other));
+  EXPECT_LE(many.median_m, at(p.truth) + 2e-3);
+  std::printf("start %.2f cm, one search %.2f cm, six %.2f cm, truth %.2f cm\n", 100 * one.start_median_m, 100 * one.median_m,
+              100 * many.median_m, 100 * at(p.truth));
+  EXPECT_NE(error_of([&] { calib::lowest_median_pose(p.ref, p.other, off, 0, {}, 1.0, 0); }).find("starts"), std::string::npos);
+}
+
 TEST(SkeletonCalib, NothingToSolveIsAClearError) {
   const auto p = simulate("walk", 1, 5);
   std::vector<calib::TimedSkeleton> late = p.other;

@@ -34,6 +34,7 @@ struct SkelOptions {
   std::string ref, other, out, ref_pose;
   double threshold_m = 0.12, clock_search_ms = 0, robust_scale_m = 0.05;
   bool holdout = false, json = false, best_rigid = false;
+  int best_rigid_starts = 1;
 };
 
 // Each sensor's skeletons of one input, on one clock (a recording's log
@@ -185,8 +186,9 @@ nlohmann::json calibrate_one(const std::string& path, const SkelOptions& o, skel
     j["held_out_median_distance_cm"] = {{"before", num(cm(b))}, {"after", num(cm(a))}};
     if (o.best_rigid) {
       // The floor: the best rigid pose found near the chosen one for the held-out half itself.
-      const auto floor = calib::lowest_median_pose(test_ref, test_oth, chosen, chosen_offset, upper, 2.0);
+      const auto floor = calib::lowest_median_pose(test_ref, test_oth, chosen, chosen_offset, upper, 2.0, o.best_rigid_starts);
       j["held_out_best_rigid_median_cm"] = num(cm(floor.median_m));
+      j["held_out_best_rigid_starts"] = floor.starts;
     }
     auto& held_out = j["held_out_joints"] = nlohmann::json::array();
     for (auto jid : upper) held_out.push_back(skeleton::joint_name(jid));
@@ -553,10 +555,15 @@ void add_calib_command(CLI::App& app, GlobalOptions&, Action& run) {
                 "search the other sensor's clock offset within +-this (0: the clocks agree)")
       ->check(kNonNegative);
   auto* holdout = s->add_flag("--holdout", o->holdout, "fit on the first half of each input, report distances on the second half");
-  s->add_flag("--best-rigid", o->best_rigid,
+  auto* best_rigid = s->add_flag("--best-rigid", o->best_rigid,
               "with --holdout: also search for the rigid pose with the lowest median on the second half itself (a "
               "local search from the fit; 2.8 s more for the 13 KinectMultiTrack files): the floor no calibration can beat there")
       ->needs(holdout);
+  s->add_option("--best-rigid-starts", o->best_rigid_starts,
+                "with --best-rigid: search from the fit and from this many - 1 poses around it (up to 10 degrees and 30 cm "
+                "off, fixed seed), keeping the lowest (default 1)")
+      ->check(CLI::Range(1, 1000))
+      ->needs(best_rigid);
   s->add_option("--out", o->out, "write a calibration file (YAML; e.g. bringup/calib/NAME.yaml)");
   s->add_option("--ref-pose", o->ref_pose, "a calibration file with the reference sensor's pose in the world (default: the reference is the world)")
       ->check(CLI::ExistingFile);

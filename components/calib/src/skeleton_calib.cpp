@@ -7,6 +7,7 @@
 #include <map>
 #include <optional>
 #include <random>
+#include <stdexcept>
 
 namespace skelgraph::calib {
 
@@ -320,7 +321,10 @@ std::vector<double> joint_distances(const std::vector<TimedSkeleton>& reference,
   return out;
 }
 
-LowestMedian lowest_median_pose(const std::vector<TimedSkeleton>& reference, const std::vector<TimedSkeleton>& other,
+namespace {
+
+// One local search (see lowest_median_pose) from `start`.
+LowestMedian lowest_median_near(const std::vector<TimedSkeleton>& reference, const std::vector<TimedSkeleton>& other,
                                 const Eigen::Isometry3d& start, std::int64_t clock_offset_ns,
                                 const std::vector<JointId>& joints, double max_match_m) {
   using V6 = Eigen::Matrix<double, 6, 1>;
@@ -383,6 +387,29 @@ LowestMedian lowest_median_pose(const std::vector<TimedSkeleton>& reference, con
   }
   out.reference_from_other = pose_of(best);
   out.median_m = best_f;
+  return out;
+}
+
+}  // namespace
+
+LowestMedian lowest_median_pose(const std::vector<TimedSkeleton>& reference, const std::vector<TimedSkeleton>& other,
+                                const Eigen::Isometry3d& start, std::int64_t clock_offset_ns,
+                                const std::vector<JointId>& joints, double max_match_m, int starts) {
+  if (starts < 1) throw CalibError("lowest_median_pose: starts must be at least 1");
+  auto out = lowest_median_near(reference, other, start, clock_offset_ns, joints, max_match_m);
+  std::mt19937_64 rng(20261203);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int k = 1; k < starts; ++k) {
+    Vector3d axis(u(rng), u(rng), u(rng));
+    if (axis.norm() < 1e-6) axis = Vector3d::UnitY();
+    const double angle = 10.0 * M_PI / 180.0 * std::abs(u(rng));
+    Eigen::Isometry3d d = Eigen::Isometry3d::Identity();
+    d.linear() = Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
+    d.translation() = 0.3 * Vector3d(u(rng), u(rng), u(rng));
+    const auto r = lowest_median_near(reference, other, d * start, clock_offset_ns, joints, max_match_m);
+    if (r.median_m < out.median_m) out.reference_from_other = r.reference_from_other, out.median_m = r.median_m;
+  }
+  out.starts = starts;
   return out;
 }
 

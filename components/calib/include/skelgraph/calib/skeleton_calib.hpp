@@ -86,14 +86,19 @@ std::vector<double> joint_distances(const std::vector<TimedSkeleton>& reference,
 // scored on, it says what no rigid pose nearby can beat there: how much of
 // the remaining disagreement is the pose and how much the trackers' own
 // (a view-dependent placement no rigid transform removes).
+// `starts` > 1 also searches from starts - 1 other poses around `start`
+// (rotations of up to 10 degrees about random axes and shifts of up to
+// 30 cm, from a fixed seed) and keeps the lowest: a median over matched
+// joints has local minima, so one search alone could stop in one.
 struct LowestMedian {
   Eigen::Isometry3d reference_from_other = Eigen::Isometry3d::Identity();
   double median_m = 0;       // at that pose
   double start_median_m = 0;  // at `start`
+  int starts = 1;             // searches run
 };
 LowestMedian lowest_median_pose(const std::vector<TimedSkeleton>& reference, const std::vector<TimedSkeleton>& other,
                                 const Eigen::Isometry3d& start, std::int64_t clock_offset_ns = 0,
-                                const std::vector<skeleton::JointId>& joints = {}, double max_match_m = 1.0);
+                                const std::vector<skeleton::JointId>& joints = {}, double max_match_m = 1.0, int starts = 1);
 
 double median(std::vector<double> v);  // NaN when empty
 
