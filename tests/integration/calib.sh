@@ -41,6 +41,17 @@ ok "skeleton calibration: sensor2 within 3 cm and 1 degree of the truth"
 # and (the search starts at the fit and never ends worse) not above the fit's. Its search is tested in test_calib.
 json_check "$WORK/holdout.json" '0 < d[0]["held_out_best_rigid_median_cm"] <= d[0]["held_out_median_distance_cm"]["after"] + 0.05' 
 json_check "$WORK/holdout.json" 'd[0]["held_out_joints"] == ["head", "neck", "torso", "left_shoulder", "right_shoulder", "left_elbow", "right_elbow", "left_hand", "right_hand"] and d[0]["held_out_median_distance_cm"]["after"] < d[0]["held_out_median_distance_cm"]["before"]'
+# --best-rigid-starts: more searches, reported, and never a higher floor; it needs --best-rigid.
+"$S" calib skeleton "$WORK/walk.mcap" --ref sensor1 --holdout --best-rigid --best-rigid-starts 3 --json >"$WORK/holdout3.json" 2>"$WORK/calib.err" \
+  || fail "calib skeleton --best-rigid-starts 3: $(cat "$WORK/calib.err")"
+python3 - "$WORK/holdout.json" "$WORK/holdout3.json" <<'PY' || fail "--best-rigid-starts"
+import json, sys
+one, three = (json.load(open(f))[0] for f in sys.argv[1:])
+assert one["held_out_best_rigid_starts"] == 1 and three["held_out_best_rigid_starts"] == 3, (one["held_out_best_rigid_starts"], three["held_out_best_rigid_starts"])
+assert 0 < three["held_out_best_rigid_median_cm"] <= one["held_out_best_rigid_median_cm"] + 0.05, (three["held_out_best_rigid_median_cm"], one["held_out_best_rigid_median_cm"])
+PY
+"$S" calib skeleton "$WORK/walk.mcap" --ref sensor1 --holdout --best-rigid-starts 3 >/dev/null 2>"$WORK/calib.err" && fail "--best-rigid-starts without --best-rigid was accepted"
+grep -q -- "--best-rigid-starts requires --best-rigid" "$WORK/calib.err" || fail "--best-rigid-starts error: $(cat "$WORK/calib.err")"
 ok "calib --holdout: upper-body distance on the unseen half, $(python3 -c 'import json,sys; h=json.load(open(sys.argv[1]))[0]["held_out_median_distance_cm"]; print("%.1f -> %.1f cm" % (h["before"], h["after"]))' "$WORK/holdout.json")"
 
 # Checkerboard: intrinsics of each sensor from its own views, then the
