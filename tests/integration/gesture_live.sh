@@ -71,6 +71,11 @@ assert b["test_noise_scale"] == 0 and a["test_noise_scale"] == 1, (a["test_noise
 s0, s1 = b["spotting"], a["spotting"]
 assert s0["truth"] == 12 and s0["recall"] >= 0.8, s0
 assert s0["median_target_error_m"] < 0.08 and s0["median_target_error_m"] < s1["median_target_error_m"], (s0["median_target_error_m"], s1["median_target_error_m"])
+# The whole-hold reference: one per true pointing hold, and as close without the noise.
+r0, r1 = b["whole_hold_reference"], a["whole_hold_reference"]
+assert r0["holds"] == r1["holds"] == s0["truth"], (r0["holds"], r1["holds"], s0["truth"])
+assert r0["median_target_error_m"] < 0.08 and r0["median_target_error_m"] < r1["median_target_error_m"], (r0, r1)
+assert r0["within_15_cm"] <= r0["holds"] and b["spotted_within_15_cm"] <= s0["true_positive"], (r0, b["spotted_within_15_cm"])
 print("median target error, noise 1 -> 0: %.1f -> %.1f cm" % (100 * s1["median_target_error_m"], 100 * s0["median_target_error_m"]))
 PY
 ok "offline: without the trackers' noise the targets are within a few cm"

@@ -7,7 +7,6 @@
 #include <map>
 #include <optional>
 #include <random>
-#include <stdexcept>
 
 namespace skelgraph::calib {
 
