@@ -154,7 +154,7 @@ void to_json(nlohmann::json& j, const PointCloud& v) {
 }
 void to_json(nlohmann::json& j, const TopicStats& v) {
   j = {{"topic", v.topic()}, {"is_output", v.is_output()}, {"count", v.count()},
-       {"rate_hz", v.rate_hz()}, {"dropped", v.dropped()}};
+       {"rate_hz", v.rate_hz()}, {"dropped", v.dropped()}, {"instances", v.instances()}};
 }
 void to_json(nlohmann::json& j, const ComponentStatus& v) {
   j = {{"component_name", v.component_name()}, {"kind", v.kind()},

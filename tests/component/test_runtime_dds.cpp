@@ -3,7 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include "../support/test_support.hpp"
@@ -132,6 +134,132 @@ TEST(RuntimeDds, TransientLocalReachesLateJoiner) {
   ASSERT_TRUE(got.wait_count(1));
   EXPECT_EQ(got.items()[0].sensor_id().to_string(), "kinect_b");
   EXPECT_DOUBLE_EQ(got.items()[0].translation().z(), 2.0);
+}
+
+// A cell that runs all day: more people than Fast DDS's default of 10
+// instances per writer come and go; each one who leaves is disposed, readers
+// hear of it at once (with the last sample: who it was), and nothing fails.
+TEST(RuntimeDds, KeyedWritersDisposeWhoLeftAndNeverRunOutOfInstances) {
+  for (const auto& topic : {topics::kSkeletonFused, topics::kSkeletonTruth}) {  // best-effort and reliable
+    SCOPED_TRACE(topic.name);
+    Context a("lifecycle_writer", test::test_config());
+    Context b("lifecycle_reader", test::test_config());
+    test::Collector<std::uint32_t> seen, gone;
+    std::set<std::uint32_t> alive_seen;
+    Subscription<msg::Skeleton> sub(
+        b, topic, [&](const msg::Skeleton& s, const SampleMeta&) { seen.add(s.person_id()); },
+        [&](const msg::Skeleton& last, const SampleMeta&) {
+          EXPECT_EQ(last.sensor_id().to_string(), "fused");
+          gone.add(last.person_id());
+        });
+    Publisher<msg::Skeleton> pub(a, topic);
+    b.executor().start();
+    ASSERT_TRUE(pub.wait_for_matched(1, 10s));
+    ASSERT_TRUE(sub.wait_for_matched(1, 10s));
+    // 40 people, 3 in the cell at a time: each written a few times, then disposed.
+    for (std::uint32_t id = 1; id <= 40; ++id) {
+      msg::Skeleton s;
+      s.sensor_id("fused");
+      s.person_id(id);
+      for (int k = 0; k < 3; ++k) {
+        s.frame_number(static_cast<std::uint64_t>(k));
+        ASSERT_TRUE(pub.publish(s)) << "person " << id;
+      }
+      ASSERT_TRUE(seen.wait([&](const std::vector<std::uint32_t>& v) {
+        return std::find(v.begin(), v.end(), id) != v.end();
+      }));
+      if (id >= 3) {
+        msg::Skeleton key;
+        key.sensor_id("fused");
+        key.person_id(id - 2);
+        ASSERT_TRUE(pub.dispose(key)) << "person " << id - 2;
+        EXPECT_FALSE(pub.dispose(key));  // once
+      }
+      EXPECT_LE(pub.live_instances(), 3u);
+    }
+    ASSERT_TRUE(gone.wait_count(38));
+    auto g = gone.items();
+    std::sort(g.begin(), g.end());
+    for (std::uint32_t id = 1; id <= 38; ++id) EXPECT_EQ(g[id - 1], id);
+    EXPECT_EQ(pub.live_instances(), 2u);
+    EXPECT_EQ(sub.instances_held(), 2u);
+    ASSERT_TRUE(b.executor().run_sync([] {}, 5s));
+    for (const auto& c : a.counters()) {
+      EXPECT_EQ(c->dropped.load(), 0u) << c->topic;
+      if (c->topic == topic.name) {
+        EXPECT_EQ(c->instances.load(), 2u);
+      }
+    }
+    EXPECT_EQ(a.health().first, HealthState::Ok) << a.health().second;
+    EXPECT_EQ(b.health().first, HealthState::Ok) << b.health().second;
+  }
+}
+
+// Idle instances (a replayed recording cannot tell who left) are disposed by
+// dispose_idle, on the caller's clock.
+TEST(RuntimeDds, DisposeIdleEndsInstancesNotWrittenSince) {
+  Context a("idle_writer", test::test_config());
+  Context b("idle_reader", test::test_config());
+  test::Collector<std::string> gone;
+  Subscription<msg::Skeleton> sub(
+      b, topics::kSkeletonRaw, [](const msg::Skeleton&, const SampleMeta&) {},
+      [&](const msg::Skeleton& last, const SampleMeta&) {
+        gone.add(last.sensor_id().to_string() + "/" + std::to_string(last.person_id()));
+      });
+  Publisher<msg::Skeleton> pub(a, topics::kSkeletonRaw);
+  b.executor().start();
+  ASSERT_TRUE(pub.wait_for_matched(1, 10s));
+  ASSERT_TRUE(sub.wait_for_matched(1, 10s));
+  msg::Skeleton s;
+  s.sensor_id("kinect_a");
+  for (std::uint32_t id : {1u, 2u, 3u}) {
+    s.person_id(id);
+    ASSERT_TRUE(pub.publish(s));
+  }
+  ASSERT_TRUE(b.executor().run_sync([] {}, 5s));
+  const auto cut = Context::monotonic_ns();
+  s.person_id(2);
+  // Written again after the cut: stays. (Best effort: the reader must have it
+  // alive before the others' disposal, so write until it has.)
+  ASSERT_TRUE(pub.publish(s));
+  EXPECT_EQ(pub.dispose_idle(cut), 2u);
+  EXPECT_EQ(pub.live_instances(), 1u);
+  ASSERT_TRUE(gone.wait_count(2));
+  auto g = gone.items();
+  std::sort(g.begin(), g.end());
+  EXPECT_EQ(g, (std::vector<std::string>{"kinect_a/1", "kinect_a/3"}));
+}
+
+// A write DDS refuses is never silent: counted, and the component is DEGRADED.
+TEST(RuntimeDds, FailedWriteMakesTheComponentDegraded) {
+  Context a("cramped_writer", test::test_config());
+  // A topic with room for 2 instances, and nobody leaving.
+  const TopicDef<msg::Skeleton> cramped{"skelgraph/test/cramped", {Reliability::BestEffort, Durability::Volatile, 1, 2}};
+  Publisher<msg::Skeleton> pub(a, cramped);
+  msg::Skeleton s;
+  s.sensor_id("fused");
+  s.person_id(1);
+  EXPECT_TRUE(pub.publish(s));
+  s.person_id(2);
+  EXPECT_TRUE(pub.publish(s));
+  a.set_health(HealthState::Ok, "fusing 2 sensor(s)");
+  EXPECT_EQ(a.health().first, HealthState::Ok);
+  s.person_id(3);
+  EXPECT_FALSE(pub.publish(s));
+  const auto [state, message] = a.health();
+  EXPECT_EQ(state, HealthState::Degraded);
+  EXPECT_NE(message.find("1 write(s) failed on skelgraph/test/cramped"), std::string::npos) << message;
+  std::uint64_t dropped = 0;
+  for (const auto& c : a.counters()) dropped += c->dropped.load();
+  EXPECT_EQ(dropped, 1u);
+  // A person leaving frees room: the next one is written.
+  s.person_id(1);
+  EXPECT_TRUE(pub.dispose(s));
+  s.person_id(3);
+  EXPECT_TRUE(pub.publish(s));
+  // Still DEGRADED for a while after the failure, and for the whole run in the final report.
+  EXPECT_EQ(a.health().first, HealthState::Degraded);
+  EXPECT_EQ(a.health(std::chrono::nanoseconds(0)).first, HealthState::Ok);
 }
 
 TEST(RuntimeDds, TopicBoundToOneType) {

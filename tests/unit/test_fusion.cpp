@@ -255,6 +255,53 @@ TEST(Fusion, PeopleStayApartAndKeepTheirIdsWhenOneSensorLosesThem) {
   EXPECT_NE(id_at_x.at(-1), id_at_x.at(1));
 }
 
+// A cell that runs all day: a person whose every sensor said it lost them is
+// gone at the next fusion step, not after person_timeout; one still seen by
+// another sensor stays; one nobody disposes is forgotten after the timeout.
+// Each departure is handed out once (the component disposes the instance).
+TEST(Fusion, APersonEverySensorLostIsGoneAtOnceAndDepartsOnce) {
+  auto f = make(fusion::Method::Kalman);
+  std::int64_t t = 0;
+  const auto step = [&](bool a_s1, bool a_s2, bool b_s1) {
+    t += 33 * kMs;
+    if (a_s1) f.add(in_sensor(person("s1", 11, {-1, 1, 0}), kS1), t);
+    if (a_s2) f.add(in_sensor(person("s2", 3, {-1.02, 1, 0}), kS2), t);
+    if (b_s1) f.add(in_sensor(person("s1", 12, {1, 1, 0}), kS1), t);
+    return f.fuse(t + kMs);
+  };
+  for (int k = 0; k < 10; ++k) ASSERT_EQ(step(true, true, true).size(), 2u);
+  EXPECT_TRUE(f.take_departed().empty());
+  std::uint32_t a = 0, b = 0;
+  for (const auto& s : step(true, true, true)) (s[JointId::Torso].position.x() < 0 ? a : b) = s.person_id;
+  // Sensor 1 loses person A: sensor 2 still sees them, so they stay, with the same id.
+  f.remove("s1", 11);
+  auto out = step(false, true, true);
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_TRUE(f.take_departed().empty());
+  EXPECT_TRUE(std::any_of(out.begin(), out.end(), [&](const auto& s) { return s.person_id == a; }));
+  // Sensor 2 loses them too: gone at the next step, far inside person_timeout (1 s).
+  f.remove("s2", 3);
+  out = step(false, false, true);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].person_id, b);
+  EXPECT_EQ(f.take_departed(), std::vector<std::uint32_t>{a});
+  EXPECT_TRUE(f.take_departed().empty());  // once
+  EXPECT_EQ(f.stats().streams_ended, 2u);
+  f.remove("s2", 3);    // unknown by now: nothing happens
+  f.remove("s9", 1);    // an unknown sensor neither
+  // Person B's sensor just stops (a host lost, no disposal): forgotten after person_timeout.
+  for (int k = 0; k < 20; ++k) {
+    t += 33 * kMs;
+    f.fuse(t);
+  }
+  EXPECT_TRUE(f.take_departed().empty());
+  for (int k = 0; k < 20; ++k) {
+    t += 33 * kMs;
+    f.fuse(t);
+  }
+  EXPECT_EQ(f.take_departed(), std::vector<std::uint32_t>{b});
+}
+
 TEST(Fusion, TwoTracksOfOnePersonBecomeOne) {
   // The sensors' first skeletons disagree by a metre (a tracker starting up),
   // so each starts its own fused person; once they agree, one person remains,

@@ -116,3 +116,30 @@ TEST(LaunchFile, HostWithoutComponentsIsAnError) {
   const auto e = error_of("components:\n  - {name: a, type: sim, host: h1}\n", "h9");
   EXPECT_NE(e.find("no components for host 'h9' (hosts named there: h1)"), std::string::npos) << e;
 }
+
+// skelgraph launch FILE --set COMPONENT.KEY=VALUE: over the file's values,
+// checked like them; a bad one says which and why.
+TEST(LaunchFile, CommandLineSetsParamsOverTheFile) {
+  auto spec = parse_launch_text("components:\n  - name: sync\n    type: sync_master\n    params: {label: walk}\n"
+                                "  - name: sim_a\n    type: sim\n",
+                                "cell.yaml");
+  set_launch_params(spec, {"sync.label=shift", "sim_a.sensors=4", "sync.tick_period_ms=20"});
+  const auto all = resolve_launch(spec, registry(), "");
+  EXPECT_EQ(all[0].params.get<std::string>("label"), "shift");
+  EXPECT_DOUBLE_EQ(all[0].params.get<double>("tick_period_ms"), 20.0);
+  EXPECT_EQ(all[1].params.get<std::int64_t>("sensors"), 4);
+  const auto error = [&](const std::string& a) {
+    auto s = spec;
+    try {
+      set_launch_params(s, {a});
+      resolve_launch(s, registry(), "");
+    } catch (const LaunchError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(error("fusion.method=avg").find("--set fusion.method=avg: cell.yaml has no component 'fusion' (it has: sync, sim_a)"),
+            std::string::npos);
+  EXPECT_NE(error("sim_a=4").find("expected COMPONENT.KEY=VALUE"), std::string::npos);
+  EXPECT_NE(error("sim_a.sensors=99").find("--set sim_a.sensors=99"), std::string::npos) << error("sim_a.sensors=99");
+}

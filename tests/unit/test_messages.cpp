@@ -8,6 +8,8 @@
 #include "skelgraph/msg/messages.hpp"
 #include "skelgraph/msg/raw_type.hpp"
 
+#include <fastrtps/utils/md5.h>
+
 using namespace skelgraph::msg;
 using eprosima::fastrtps::rtps::SerializedPayload_t;
 
@@ -111,4 +113,34 @@ TEST(Messages, JointNames) {
   EXPECT_STREQ(joint_name(JOINT_HEAD), "head");
   EXPECT_STREQ(joint_name(JOINT_RIGHT_FOOT), "right_foot");
   EXPECT_STREQ(joint_name(static_cast<JointId>(99)), "unknown");
+}
+
+// An instance's key hash is the MD5 of its key in big-endian CDR with zero
+// padding, whatever keys the same type support hashed before (the generated
+// code hashed leftover padding: one person got several instances when a
+// participant wrote "truth" and "sensor1" skeletons; idl/patch_generated.cmake).
+TEST(Messages, KeyHashIsTheKeysAloneWhateverCameBefore) {
+  SkeletonPubSubType support;
+  const auto hash = [&](const std::string& sensor, std::uint32_t person) {
+    Skeleton s;
+    s.sensor_id(sensor);
+    s.person_id(person);
+    s.frame_number(person * 7u);  // not part of the key
+    eprosima::fastrtps::rtps::InstanceHandle_t h;
+    EXPECT_TRUE(support.getKey(&s, &h, false));
+    std::vector<std::uint8_t> v;
+    for (unsigned i = 0; i < 16; ++i) v.push_back(h.value[i]);
+    return v;
+  };
+  const auto truth = hash("truth", 1);
+  EXPECT_EQ(hash("sensor123", 0xffffffffu).size(), 16u);  // fills the padding after "truth" with other bytes
+  EXPECT_EQ(hash("truth", 1), truth);
+  // Independently: length 6 ("truth" and its terminator), 2 bytes of zero padding, then the id.
+  const std::uint8_t key[] = {0, 0, 0, 6, 't', 'r', 'u', 't', 'h', 0, 0, 0, 0, 0, 0, 1};
+  MD5 md5;
+  md5.init();
+  md5.update(key, sizeof key);
+  md5.finalize();
+  EXPECT_EQ(truth, std::vector<std::uint8_t>(md5.digest, md5.digest + 16));
+  EXPECT_NE(hash("truth", 2), truth);
 }

@@ -1,7 +1,9 @@
 // The simulator's core: scenarios, sensors, tracker model, determinism.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <map>
 #include <set>
 
 #include "skelgraph/sim/rng.hpp"
@@ -41,6 +43,7 @@ TEST(SimRng, SameSeedSameNumbersAndForksAreIndependent) {
 TEST(SimScenario, EveryScenarioRunsWithConstantBonesAndIsSeeded) {
   const auto body = sim::BodyDimensions::from_height(1.75);
   for (const auto& name : sim::scenario_names()) {
+    if (name == "shift") continue;  // people come and go: SimShift below
     SCOPED_TRACE(name);
     sim::ScenarioOptions o;
     o.name = name;
@@ -392,4 +395,91 @@ TEST(Simulation, RejectsBadConfigurations) {
   cfg = {};
   cfg.sensors[1].id = cfg.sensors[0].id;
   EXPECT_THROW(sim::Simulation{cfg}, std::invalid_argument);
+}
+
+// A working day: people come in one after another, work and leave, each
+// with an id of their own; the trackers lose each one and say so.
+TEST(SimShift, PeopleComeWorkAndLeaveAndEveryDepartureIsAnEvent) {
+  sim::SimConfig c;
+  c.scenario.name = "shift";
+  c.scenario.people = 3;
+  c.scenario.repeats = 4;
+  c.scenario.work_s = 6.0;
+  c.sensors = sim::default_sensors(3);
+  c.emit_departures = true;
+  sim::Simulation s(c);
+  const auto& visits = s.scenario().visits();
+  ASSERT_EQ(visits.size(), 12u);
+  for (std::size_t i = 0; i < visits.size(); ++i) {
+    EXPECT_EQ(visits[i].person_id, i + 1);  // in order of arrival
+    if (i > 0) {
+      EXPECT_GE(visits[i].enter, visits[i - 1].enter);
+    }
+    EXPECT_GT(visits[i].leave - visits[i].enter, 6.0 * 0.5);
+  }
+  // At most one person per place at a time, and they arrive and leave outside every view.
+  for (std::size_t i = 0; i < visits.size(); ++i) {
+    for (std::size_t j = i + 1; j < visits.size(); ++j) {
+      if (visits[i].slot == visits[j].slot) {
+        EXPECT_TRUE(visits[j].enter >= visits[i].leave || visits[i].enter >= visits[j].leave);
+      }
+    }
+  }
+  const auto body = sim::BodyDimensions::from_height(1.75);
+  for (const auto& v : visits) {
+    const auto scene = s.scenario().at(v.enter + 0.01);
+    const auto it = std::find_if(scene.actors.begin(), scene.actors.end(), [&](const sim::Actor& a) { return a.person_id == v.person_id; });
+    ASSERT_NE(it, scene.actors.end());
+    EXPECT_EQ(it->slot, v.slot);
+    const auto truth = sim::forward_kinematics(body, it->pose);
+    for (const auto& sc : c.sensors) EXPECT_FALSE(sim::SensorView(sc).in_view(truth[JointId::Torso].position)) << v.person_id;
+  }
+
+  std::map<std::uint32_t, std::pair<double, double>> truth_span;  // first, last truth
+  std::map<std::uint32_t, double> left;
+  std::map<std::pair<std::size_t, std::uint32_t>, double> raw_last, lost;
+  std::set<std::uint32_t> tracked_people;
+  for (const auto& e : s.advance(s.duration() + 1.0)) {
+    const auto id = e.skeleton.person_id;
+    switch (e.kind) {
+      case sim::SimEvent::Kind::Truth:
+        ASSERT_FALSE(left.count(id)) << "truth of " << id << " after they left";
+        if (!truth_span.count(id)) truth_span[id] = {e.t, e.t};
+        truth_span[id].second = e.t;
+        break;
+      case sim::SimEvent::Kind::Left:
+        ASSERT_TRUE(truth_span.count(id));
+        ASSERT_FALSE(left.count(id)) << id << " left twice";
+        left[id] = e.t;
+        break;
+      case sim::SimEvent::Kind::Raw:
+        ASSERT_FALSE(lost.count({e.sensor, id})) << "a lost tracker user reported again";
+        raw_last[{e.sensor, id}] = e.t;
+        if (e.actor != 0) tracked_people.insert(e.actor);  // (0: a ghost of someone gone)
+        break;
+      case sim::SimEvent::Kind::Lost:
+      {
+        const std::pair<std::size_t, std::uint32_t> key{e.sensor, id};
+        ASSERT_TRUE(raw_last.count(key));
+        ASSERT_FALSE(lost.count(key));
+        lost[key] = e.t;
+        EXPECT_GT(e.t, raw_last[key]);
+        break;
+      }
+      default:
+        break;
+    }
+  }
+  EXPECT_EQ(truth_span.size(), 12u);
+  EXPECT_EQ(left.size(), 12u);            // everyone left, once
+  EXPECT_EQ(tracked_people.size(), 12u);  // and every one was seen by a tracker
+  EXPECT_EQ(lost.size(), raw_last.size());  // every tracker user ended, none left over
+  for (const auto& v : visits) EXPECT_NEAR(left[v.person_id], v.leave, 0.04);
+  EXPECT_GE(s.duration(), visits.back().leave + 5.0);  // the cell is empty at the end long enough to see it
+  // Without emit_departures (offline tools): the same truth and raw events, none of the new kinds.
+  c.emit_departures = false;
+  sim::Simulation quiet(c);
+  for (const auto& e : quiet.advance(quiet.duration() + 1.0)) {
+    EXPECT_TRUE(e.kind == sim::SimEvent::Kind::Truth || e.kind == sim::SimEvent::Kind::Raw);
+  }
 }

@@ -55,6 +55,21 @@ TEST(ViewerScene, JointStatesFromConfidence) {
   EXPECT_EQ(stream_kind("kinect2"), StreamKind::Raw);
 }
 
+// A person whose stream disposed them (they left) is not drawn from then
+// on, even while their last skeleton would still be young; the others are.
+TEST(ViewerScene, APersonWhoLeftIsNoLongerDrawn) {
+  Scene scene;
+  scene.on_skeleton(person("fused", 1, "world", 1), 0);
+  scene.on_skeleton(person("fused", 2, "world", 1), 0);
+  EXPECT_EQ(scene.skeletons_held(), 2u);
+  scene.on_gone("fused", 1);
+  scene.on_gone("fused", 9);  // never seen: nothing happens
+  EXPECT_EQ(scene.skeletons_held(), 1u);
+  const auto f = scene.frame(10 * kMs);
+  ASSERT_EQ(f["skeletons"].size(), 1u);
+  EXPECT_EQ(f["skeletons"][0]["person"], 2);
+}
+
 TEST(ViewerScene, RawSkeletonsArePlacedWithTheirSensorsPose) {
   Scene scene;
   auto s = person("sensor1", 1, "sensor1", 7);

@@ -77,6 +77,8 @@ void add_components_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_sim_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_bag_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_eval_command(CLI::App& app, GlobalOptions& g, Action& run);
+// `eval presence`, added by add_eval_command.
+void add_eval_presence_command(CLI::App& eval, GlobalOptions& g, Action& run);
 void add_fuse_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_calib_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_gesture_command(CLI::App& app, GlobalOptions& g, Action& run);

@@ -785,6 +785,7 @@ void add_eval_command(CLI::App& app, GlobalOptions& g, Action& run) {
   l->add_option("--csv", lo->score.csv, "also write the table as CSV to this file (a row per stream)");
   add_dds_options(*l, g);
   l->callback([lo, &g, &run] { run = [lo, &g] { return eval_live(*lo, g); }; });
+  add_eval_presence_command(*ev, g, run);
 }
 
 }  // namespace skelgraph::cli

@@ -85,6 +85,7 @@ DepthTrackerComponent::DepthTrackerComponent(runtime::Context& ctx, const runtim
 
 void DepthTrackerComponent::on_depth_merged(depth::DepthImage image, std::int64_t receive_ns) {
   std::vector<skeleton::Skeleton> people;
+  std::vector<std::uint32_t> gone;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     if (poses_.find(image.sensor_id) == poses_.end()) {
@@ -110,11 +111,13 @@ void DepthTrackerComponent::on_depth_merged(depth::DepthImage image, std::int64_
     }
     const auto t0 = std::chrono::steady_clock::now();
     people = merged_->track_merged(images, poses, merged_id_);
+    gone = merged_->take_dropped();
     merged_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     ++merged_fits_;
     merged_skeletons_ += people.size();
     if (merged_fits_ == 1) ctx_.set_health(runtime::HealthState::Ok, "tracking (merged views)");
   }
+  dispose(merged_id_, gone);
   std::int64_t stamp = 0;
   for (const auto& p : people) {
     stamp = p.stamp_ns;
@@ -137,6 +140,7 @@ void DepthTrackerComponent::on_depth(const msg::DepthFrame& frame) {
     return;
   }
   std::vector<skeleton::Skeleton> people;
+  std::vector<std::uint32_t> gone;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     auto it = sensors_.find(image.sensor_id);
@@ -162,11 +166,13 @@ void DepthTrackerComponent::on_depth(const msg::DepthFrame& frame) {
     }
     const auto t0 = std::chrono::steady_clock::now();
     people = s.tracker.track(image);
+    gone = s.tracker.take_dropped();
     s.track_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     ++s.frames;
     s.skeletons += people.size();
     if (s.frames == 1) ctx_.set_health(runtime::HealthState::Ok, "tracking");
   }
+  dispose(image.sensor_id, gone);
   for (const auto& p : people) raw_pub_.publish(skeleton::to_msg(p));
   msg::SensorFrame f;
   f.sensor_id(image.sensor_id);
@@ -174,6 +180,16 @@ void DepthTrackerComponent::on_depth(const msg::DepthFrame& frame) {
   f.frame_number(image.frame_number);
   f.people(static_cast<std::uint32_t>(people.size()));
   frame_pub_.publish(f);
+}
+
+// People the tracker forgot: their raw instances are disposed, so readers know at once.
+void DepthTrackerComponent::dispose(const std::string& sensor, const std::vector<std::uint32_t>& people) {
+  for (const auto id : people) {
+    msg::Skeleton key;
+    key.sensor_id(sensor);
+    key.person_id(id);
+    raw_pub_.dispose(key);
+  }
 }
 
 std::string DepthTrackerComponent::summary() const {

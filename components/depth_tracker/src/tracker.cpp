@@ -1,6 +1,7 @@
 #include "skelgraph/depth_tracker/tracker.hpp"
 
 #include <algorithm>
+#include <utility>
 #include <array>
 #include <cmath>
 #include <initializer_list>
@@ -195,6 +196,7 @@ struct DepthTracker::Impl {
   Eigen::Isometry3d world_from_sensor = Eigen::Isometry3d::Identity();
   std::vector<Person> people;
   std::uint32_t next_id = 1;
+  std::vector<std::uint32_t> dropped;  // forgotten since take_dropped()
   TrackerStats stats;
 
   struct Fit {
@@ -224,6 +226,8 @@ DepthTracker& DepthTracker::operator=(DepthTracker&&) noexcept = default;
 
 void DepthTracker::set_pose(const Eigen::Isometry3d& world_from_sensor) { impl_->world_from_sensor = world_from_sensor; }
 const Eigen::Isometry3d& DepthTracker::pose() const { return impl_->world_from_sensor; }
+std::vector<std::uint32_t> DepthTracker::take_dropped() { return std::exchange(impl_->dropped, {}); }
+
 const TrackerStats& DepthTracker::stats() const { return impl_->stats; }
 const TrackerOptions& DepthTracker::options() const { return impl_->opt; }
 
@@ -513,8 +517,12 @@ std::vector<skeleton::Skeleton> DepthTracker::Impl::step(std::vector<PersonPoint
   // Forget people not seen for a while.
   const auto lost_ns = static_cast<std::int64_t>(opt.lost_after_s * 1e9);
   people.erase(std::remove_if(people.begin(), people.end(),
-                                [&](const Person& p) { return stamp_ns - p.last_seen_ns > lost_ns; }),
-                 people.end());
+                              [&](const Person& p) {
+                                if (stamp_ns - p.last_seen_ns <= lost_ns) return false;
+                                dropped.push_back(p.id);
+                                return true;
+                              }),
+               people.end());
 
   std::vector<skeleton::Skeleton> out;
   for (const auto& person : people) {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <deque>
 #include <limits>
+#include <utility>
 
 #include "skelgraph/fusion/joint_filter.hpp"
 
@@ -110,6 +111,8 @@ struct Fuser::Impl {
   std::vector<Track> tracks;
   std::uint32_t next_track_id = 1;
   std::uint64_t frame_number = 0;
+  std::vector<std::uint32_t> ended;     // tracks that lost a stream by remove(): gone if none is left
+  std::vector<std::uint32_t> departed;  // fused people forgotten since take_departed()
 
   std::size_t sensor_index(const std::string& id) {
     for (std::size_t i = 0; i < sensors.size(); ++i) {
@@ -166,11 +169,13 @@ struct Fuser::Impl {
       auto& bound = v.stream->track;
       // Two tracks of one person (the sensors' first skeletons disagreed):
       // the stream moves to the older track where it is, and the younger one,
-      // left without views, times out. Fused ids stay those of the first track.
+      // left without streams, is gone at the next step (else it would stay a
+      // second person until it timed out). Fused ids stay those of the first track.
       if (bound && has_track(*bound)) {
         for (const auto& tr : tracks) {
           if (tr.id < *bound && !taken(tr.id, v.sensor) && (tr.centre - v.centre).norm() < 0.5 * opt.match_distance_m &&
               (track_by_id(*bound).centre - tr.centre).norm() < 0.5 * opt.match_distance_m) {
+            ended.push_back(*bound);  // left without a stream, the younger one is gone at the next step
             bound = tr.id;
             ++stats.tracks_merged;
             break;
@@ -457,8 +462,23 @@ struct Fuser::Impl {
       if (it->second.samples.empty() || t - it->second.samples.back().t > opt.person_timeout_ns) it = streams.erase(it);
       else ++it;
     }
+    // A person whose every sensor said it lost them is gone at once; one
+    // nobody has reported for a while is forgotten.
+    for (const auto id : ended) {
+      const bool fed = std::any_of(streams.begin(), streams.end(),
+                                   [&](const auto& kv) { return kv.second.track && *kv.second.track == id; });
+      if (fed) continue;
+      for (auto& tr : tracks) {
+        if (tr.id == id) tr.last_ns = std::numeric_limits<std::int64_t>::min() / 2;
+      }
+    }
+    ended.clear();
     tracks.erase(std::remove_if(tracks.begin(), tracks.end(),
-                                [&](const Track& tr) { return t - tr.last_ns > opt.person_timeout_ns; }),
+                                [&](const Track& tr) {
+                                  if (t - tr.last_ns <= opt.person_timeout_ns) return false;
+                                  departed.push_back(tr.id);
+                                  return true;
+                                }),
                  tracks.end());
     std::vector<View> views;
     for (auto& [key, st] : streams) {
@@ -547,6 +567,20 @@ void Fuser::add(const skeleton::Skeleton& raw, std::int64_t t_ns) {
   while (st.samples.size() > kHistory) st.samples.pop_front();
   ++impl_->stats.added;
 }
+
+void Fuser::remove(const std::string& sensor, std::uint32_t person_id) {
+  for (std::size_t i = 0; i < impl_->sensors.size(); ++i) {
+    if (impl_->sensors[i].id != sensor) continue;
+    const auto it = impl_->streams.find({i, person_id});
+    if (it == impl_->streams.end()) return;
+    if (it->second.track) impl_->ended.push_back(*it->second.track);
+    impl_->streams.erase(it);
+    ++impl_->stats.streams_ended;
+    return;
+  }
+}
+
+std::vector<std::uint32_t> Fuser::take_departed() { return std::exchange(impl_->departed, {}); }
 
 std::vector<skeleton::Skeleton> Fuser::fuse(std::int64_t t_ns) { return impl_->fuse(t_ns); }
 

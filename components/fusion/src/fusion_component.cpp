@@ -46,10 +46,14 @@ FusionComponent::FusionComponent(runtime::Context& ctx, const runtime::Params& p
       period_ns_(static_cast<std::int64_t>(1e9 / params.get<double>("rate_hz"))),
       on_ticks_(params.get<bool>("on_ticks")),
       out_(ctx, runtime::topics::kSkeletonFused),
-      raw_sub_(ctx, runtime::topics::kSkeletonRaw,
-               [this](const msg::Skeleton& m, const runtime::SampleMeta& meta) {
-                 fuser_.add(skeleton::from_msg(m), meta.receive_ns);
-               }),
+      raw_sub_(
+          ctx, runtime::topics::kSkeletonRaw,
+          [this](const msg::Skeleton& m, const runtime::SampleMeta& meta) {
+            fuser_.add(skeleton::from_msg(m), meta.receive_ns);
+          },
+          [this](const msg::Skeleton& last, const runtime::SampleMeta&) {
+            fuser_.remove(last.sensor_id().to_string(), last.person_id());
+          }),
       frame_sub_(ctx, runtime::topics::kSensorFrame,
                  [this](const msg::SensorFrame& f, const runtime::SampleMeta& meta) {
                    fuser_.heartbeat(f.sensor_id().to_string(), meta.receive_ns);
@@ -85,7 +89,15 @@ void FusionComponent::on_start() {
 
 void FusionComponent::step(std::int64_t now_ns) {
   ++steps_;
-  for (auto s : fuser_.fuse(now_ns)) {
+  const auto fused = fuser_.fuse(now_ns);
+  // People who left: readers see their instances disposed (and the writer frees them).
+  for (const auto id : fuser_.take_departed()) {
+    msg::Skeleton key;
+    key.sensor_id(output_id_);
+    key.person_id(id);
+    if (out_.dispose(key)) ++departed_;
+  }
+  for (auto s : fused) {
     s.sensor_id = output_id_;
     out_.publish(skeleton::to_msg(s));
     ++published_;
@@ -132,7 +144,7 @@ std::string FusionComponent::summary() const {
   std::ostringstream os;
   os << method_name(fuser_.options().method) << ": " << published_ << " fused skeletons in " << steps_ << " steps ("
      << tick_steps_ << " on sync ticks), " << fuser_.sensors().size() << " sensor(s), " << dropouts_ << " dropout(s), "
-     << rejoins_ << " rejoin(s)";
+     << rejoins_ << " rejoin(s), " << departed_ << " person(s) left, " << out_.live_instances() << " in the cell";
   return os.str();
 }
 
@@ -142,6 +154,9 @@ nlohmann::json FusionComponent::details() const {
           {"steps", steps_},
           {"tick_steps", tick_steps_},
           {"published", published_},
+          {"departed", departed_},
+          {"people", out_.live_instances()},
+          {"streams_ended", st.streams_ended},
           {"sensors", fuser_.sensors()},
           {"silent", std::vector<std::string>(silent_.begin(), silent_.end())},
           {"dropouts", dropouts_},

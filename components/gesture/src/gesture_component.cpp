@@ -74,8 +74,14 @@ GestureComponent::GestureComponent(runtime::Context& ctx, const runtime::Params&
       person_timeout_ns_(static_cast<std::int64_t>(params.get<double>("person_timeout_ms") * 1e6)),
       event_pub_(ctx, runtime::topics::kGestureEvent),
       state_pub_(ctx, runtime::topics::kGestureState),
-      sub_(ctx, input_topic(params.get<std::string>("input")),
-           [this](const msg::Skeleton& m, const runtime::SampleMeta& meta) { on_skeleton(skeleton::from_msg(m), meta.receive_ns); }) {
+      sub_(
+          ctx, input_topic(params.get<std::string>("input")),
+          [this](const msg::Skeleton& m, const runtime::SampleMeta& meta) { on_skeleton(skeleton::from_msg(m), meta.receive_ns); },
+          [this](const msg::Skeleton& last, const runtime::SampleMeta&) {
+            // The person left (the writer disposed them): forgotten at once.
+            const auto it = people_.find({last.sensor_id().to_string(), last.person_id()});
+            if (it != people_.end()) forget(it);
+          }) {
   options_.point_label = params.get<std::string>("point_label");
   options_.hold = params.get<double>("hold_s");
   options_.aim = params.get<double>("aim_s");
@@ -100,7 +106,7 @@ void GestureComponent::on_start() {
     const auto now = runtime::Context::now_ns();
     for (auto it = people_.begin(); it != people_.end();) {
       if (now - it->second.last_seen_ns > person_timeout_ns_) {
-        it = people_.erase(it);
+        it = forget(it);
         continue;
       }
       publish_state(it->first.first, it->first.second, it->second);
@@ -109,6 +115,15 @@ void GestureComponent::on_start() {
     ctx_.set_health(runtime::HealthState::Ok, std::to_string(people_.size()) + " person(s) watched, " +
                                                   std::to_string(events_) + " gesture(s)");
   });
+}
+
+GestureComponent::People::iterator GestureComponent::forget(People::iterator it) {
+  msg::GestureState key;
+  key.person_id(it->first.second);
+  key.source(it->first.first);
+  state_pub_.dispose(key);
+  ++left_;
+  return people_.erase(it);
 }
 
 void GestureComponent::publish_state(const std::string& source, std::uint32_t person, const Person& p) {
@@ -123,7 +138,10 @@ void GestureComponent::publish_state(const std::string& source, std::uint32_t pe
 void GestureComponent::on_skeleton(const skeleton::Skeleton& s, std::int64_t receive_ns) {
   ++skeletons_;
   auto& p = people_[{s.sensor_id, s.person_id}];
-  if (!p.spotter) p.spotter = std::make_unique<Spotter>(classifier_, options_);
+  if (!p.spotter) {
+    p.spotter = std::make_unique<Spotter>(classifier_, options_);
+    ++seen_;
+  }
   if (s.stamp_ns <= p.last_stamp_ns) return;  // out of order or repeated
   p.last_seen_ns = receive_ns;
   p.last_stamp_ns = s.stamp_ns;
@@ -164,13 +182,14 @@ void GestureComponent::on_skeleton(const skeleton::Skeleton& s, std::int64_t rec
 
 std::string GestureComponent::summary() const {
   std::ostringstream os;
-  os << events_ << " gesture(s) in " << skeletons_ << " skeletons";
+  os << events_ << " gesture(s) in " << skeletons_ << " skeletons of " << seen_ << " person(s) (" << left_ << " left)";
   for (const auto& [label, n] : events_by_label_) os << ", " << label << " " << n;
   return os.str();
 }
 
 nlohmann::json GestureComponent::details() const {
-  return {{"skeletons", skeletons_}, {"events", events_}, {"by_label", events_by_label_}, {"people", people_.size()}};
+  return {{"skeletons", skeletons_}, {"events", events_},      {"by_label", events_by_label_},
+          {"people", people_.size()},  {"people_seen", seen_},   {"people_left", left_}};
 }
 
 }  // namespace skelgraph::gesture

@@ -15,7 +15,9 @@ runtime::ComponentInfo Playback::describe() {
       .add_bool("loop", false, "start again at the end")
       .add_bool("restamp", true, "stamp frames with the playback clock (as a live sensor would)")
       .add_string("on_error", "stop", "a bad line in a file: stop (refuse to start) or skip it", {"stop", "skip"})
-      .add_string("sensor_id", "", "sensor id to publish under (default: the format's)");
+      .add_string("sensor_id", "", "sensor id to publish under (default: the format's)")
+      .add_double("gone_after_s", 1.0,
+                  "a person missing from the data this long (wall clock) has left: their instance is disposed", 0.05, 3600.0);
   return info;
 }
 
@@ -39,6 +41,7 @@ Playback::Playback(runtime::Context& ctx, const runtime::Params& params)
   so.loop = params.get<bool>("loop");
   so.restamp = params.get<bool>("restamp");
   schedule_ = std::make_unique<PlaybackSchedule>(std::move(frames), so);
+  gone_after_ns_ = static_cast<std::int64_t>(params.get<double>("gone_after_s") * 1e9);
   if (report_.skipped > 0) {
     ctx.set_health(runtime::HealthState::Degraded, std::to_string(report_.skipped) + " bad line(s) skipped");
   }
@@ -51,7 +54,10 @@ void Playback::on_start() {
 }
 
 void Playback::tick() {
-  for (const auto& s : schedule_->due(runtime::Context::monotonic_ns() - start_mono_ns_, start_stamp_ns_)) pub_.publish(skeleton::to_msg(s));
+  const auto now = runtime::Context::monotonic_ns();
+  for (const auto& s : schedule_->due(now - start_mono_ns_, start_stamp_ns_)) pub_.publish(skeleton::to_msg(s));
+  // A data set says nothing of people leaving; one missing for a while has.
+  pub_.dispose_idle(schedule_->finished() ? now + 1 : now - gone_after_ns_);
   if (schedule_->finished()) {
     timer_.cancel();
     ctx_.set_health(runtime::HealthState::Ok, "finished");

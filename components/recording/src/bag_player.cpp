@@ -1,6 +1,7 @@
 #include "skelgraph/recording/bag_player.hpp"
 
 #include <algorithm>
+#include <climits>
 #include <queue>
 #include <sstream>
 
@@ -17,7 +18,11 @@ runtime::ComponentInfo BagPlayer::describe() {
       .add_bool("hold_at_end", false, "at the end, wait for a seek instead of finishing")
       .add_double("wait_s", 2.0, "before playing, wait up to this long for every topic to have a reader", 0.0, 60.0)
       .add_double("reorder_s", 2.0, "messages this much out of log-time order in the file are played in order", 0.0, 60.0)
-      .add_string_list("topics", {}, "only these topics (default: all but skelgraph/status)");
+      .add_string_list("topics", {}, "only these topics (default: all but skelgraph/status)")
+      .add_double("gone_after_s", 1.0,
+                  "a keyed stream (a person, a sensor) absent from the recording this long (its own time) has left: "
+                  "its instance is disposed; also at the end and on a seek",
+                  0.05, 3600.0);
   return info;
 }
 
@@ -36,6 +41,7 @@ BagPlayer::BagPlayer(runtime::Context& ctx, const runtime::Params& params)
       hold_at_end_(params.get<bool>("hold_at_end")),
       wait_ns_(static_cast<std::int64_t>(params.get<double>("wait_s") * 1e9)),
       reorder_ns_(static_cast<std::uint64_t>(params.get<double>("reorder_s") * 1e9)),
+      gone_after_ns_(static_cast<std::int64_t>(params.get<double>("gone_after_s") * 1e9)),
       reader_(open_recording(file_)) {
   const auto wanted = params.get<std::vector<std::string>>("topics");
   const auto summary = reader_.summary();  // from the summary section when there is one; else a scan
@@ -106,7 +112,9 @@ void BagPlayer::run() {
       try {
         at_end_ = false;
         play_once(from);
+        dispose_idle(INT64_MAX);  // the end of the recording: everyone has left
       } catch (const SeekTo& s) {
+        dispose_idle(INT64_MAX);  // elsewhere in the recording, other people may be there
         from = s.log_time;
         position_log_ = from;
         at_end_ = false;
@@ -217,8 +225,12 @@ void BagPlayer::play_once(std::uint64_t from) {
       return;
     }
     wait_until_due(t);
-    if (publishers_[p.publisher]->publish(p.sample)) ++published_;
+    if (publishers_[p.publisher]->publish(p.sample, static_cast<std::int64_t>(t))) ++published_;
     else ++failed_;
+    if (t - last_idle_check_ >= 100'000'000) {
+      last_idle_check_ = t;
+      dispose_idle(static_cast<std::int64_t>(t) - gone_after_ns_);
+    }
     position_log_ = t;
     player_->delivered();
     const auto now = runtime::Context::monotonic_ns();
@@ -237,6 +249,15 @@ void BagPlayer::play_once(std::uint64_t from) {
     while (!pending.empty() && pending.top().log_time + reorder_ns_ <= newest) play();
   });
   while (!pending.empty()) play();
+}
+
+// Keyed streams of live topics not seen since `before_log_ns` are disposed
+// (state topics, such as sensor poses, stay as a late joiner would find them).
+void BagPlayer::dispose_idle(std::int64_t before_log_ns) {
+  for (std::size_t i = 0; i < publishers_.size(); ++i) {
+    if (!publisher_is_state_[i]) publishers_[i]->dispose_idle(before_log_ns);
+  }
+  if (before_log_ns == INT64_MAX) last_idle_check_ = 0;
 }
 
 std::string BagPlayer::summary() const {

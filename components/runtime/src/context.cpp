@@ -380,9 +380,34 @@ void Context::set_health(HealthState state, std::string message) {
   health_message_ = std::move(message);
 }
 
-std::pair<HealthState, std::string> Context::health() const {
+std::pair<HealthState, std::string> Context::health(std::chrono::nanoseconds failure_window) const {
   std::lock_guard<std::mutex> lock(mutex_);
-  return {health_, health_message_};
+  auto state = health_;
+  auto message = health_message_;
+  const auto now = monotonic_ns();
+  for (const auto& c : counters_) {
+    const auto f = c->failures();
+    if (f.count == 0 || now - f.last_mono_ns > failure_window.count()) continue;
+    if (state == HealthState::Ok) {
+      state = HealthState::Degraded;
+      message.clear();
+    }
+    message += (message.empty() ? "" : "; ") + std::to_string(f.count) + (c->is_output ? " write(s) failed on " : " sample(s) refused on ") +
+               c->topic + " (last: " + f.last + ")";
+  }
+  return {state, message};
+}
+
+void EndpointCounter::note_failure(const std::string& what) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++failures_.count;
+  failures_.last_mono_ns = Context::monotonic_ns();
+  failures_.last = what;
+}
+
+EndpointCounter::Failures EndpointCounter::failures() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return failures_;
 }
 
 }  // namespace skelgraph::runtime

@@ -87,6 +87,7 @@ struct Graph::Node {
       t.count(count);
       t.rate_hz(dt > 0.0 ? static_cast<double>(count - last_counts[key]) / dt : 0.0);
       t.dropped(c->dropped.load());
+      t.instances(static_cast<std::uint32_t>(c->instances.load()));
       last_counts[key] = count;
       s.topics().push_back(t);
     }
@@ -233,7 +234,8 @@ std::vector<NodeReport> Graph::report() const {
     NodeReport r;
     r.name = n->context->name();
     r.kind = n->kind;
-    const auto [state, message] = n->context->health();
+    // A write that failed at any time in the run leaves the report DEGRADED.
+    const auto [state, message] = n->context->health(std::chrono::nanoseconds::max());
     r.state = to_text(state);
     r.message = message;
     r.summary = n->component->summary();

@@ -139,6 +139,35 @@ LaunchSpec parse_launch_file(const std::string& path) {
   return parse_launch_text(ss.str(), path);
 }
 
+void set_launch_params(LaunchSpec& spec, const std::vector<std::string>& assignments) {
+  for (const auto& a : assignments) {
+    const auto origin = "--set " + a;
+    const auto dot = a.find('.');
+    const auto eq = a.find('=');
+    if (dot == std::string::npos || dot == 0 || eq == std::string::npos || eq < dot + 2) {
+      throw LaunchError(origin + ": expected COMPONENT.KEY=VALUE");
+    }
+    const auto name = a.substr(0, dot);
+    auto it = std::find_if(spec.components.begin(), spec.components.end(),
+                           [&](const ComponentSpec& c) { return c.name == name; });
+    if (it == spec.components.end()) {
+      std::string known;
+      for (const auto& c : spec.components) known += (known.empty() ? "" : ", ") + c.name;
+      throw LaunchError(origin + ": " + spec.source + " has no component '" + name + "' (it has: " + known + ")");
+    }
+    RawParam p;
+    try {
+      p = parse_param_assignment(a.substr(dot + 1), origin);
+    } catch (const ParamError& e) {
+      throw LaunchError(e.what());
+    }
+    auto& params = it->params;
+    const auto same = std::find_if(params.begin(), params.end(), [&](const RawParam& q) { return q.key == p.key; });
+    if (same != params.end()) *same = std::move(p);
+    else params.push_back(std::move(p));
+  }
+}
+
 std::vector<ResolvedComponent> resolve_launch(const LaunchSpec& spec, const ComponentRegistry& registry,
                                               const std::string& host) {
   std::vector<ResolvedComponent> out;

@@ -1,5 +1,7 @@
 #include "skelgraph/runtime/pubsub.hpp"
 
+#include "skelgraph/msg/message_table.hpp"
+
 #include <atomic>
 #include <condition_variable>
 #include <mutex>
@@ -25,7 +27,7 @@ namespace dds = eprosima::fastdds::dds;
 namespace {
 
 template <class Qos>
-void apply(const QosPreset& p, Qos& q) {
+void apply(const QosPreset& p, bool keyed, Qos& q) {
   q.reliability().kind =
       p.reliability == Reliability::Reliable ? dds::RELIABLE_RELIABILITY_QOS : dds::BEST_EFFORT_RELIABILITY_QOS;
   q.durability().kind =
@@ -35,6 +37,39 @@ void apply(const QosPreset& p, Qos& q) {
   } else {
     q.history().kind = dds::KEEP_LAST_HISTORY_QOS;
     q.history().depth = p.depth;
+  }
+  // Resource limits always set here (QosPreset), never Fast DDS's defaults.
+  const int instances = keyed ? std::max(1, p.max_instances) : 1;
+  const int per_instance = p.depth > 0 ? p.depth : QosPreset::kKeepAllSamples;
+  auto& rl = q.resource_limits();
+  rl.max_instances = instances;
+  rl.max_samples_per_instance = per_instance;
+  rl.max_samples = instances * per_instance;
+  rl.allocated_samples = std::min(rl.max_samples, 100);
+}
+
+InstanceId to_id(const eprosima::fastrtps::rtps::InstanceHandle_t& h) {
+  InstanceId id{};
+  for (std::size_t i = 0; i < id.size(); ++i) id[i] = h.value[static_cast<unsigned>(i)];
+  return id;
+}
+
+eprosima::fastrtps::rtps::InstanceHandle_t to_handle(const InstanceId& id) {
+  eprosima::fastrtps::rtps::InstanceHandle_t h;
+  for (std::size_t i = 0; i < id.size(); ++i) h.value[static_cast<unsigned>(i)] = id[i];  // (marks it defined)
+  return h;
+}
+
+const char* return_code_name(int code) {
+  switch (code) {
+    case ReturnCode_t::RETCODE_OK: return "OK";
+    case ReturnCode_t::RETCODE_ERROR: return "ERROR";
+    case ReturnCode_t::RETCODE_BAD_PARAMETER: return "BAD_PARAMETER";
+    case ReturnCode_t::RETCODE_PRECONDITION_NOT_MET: return "PRECONDITION_NOT_MET";
+    case ReturnCode_t::RETCODE_OUT_OF_RESOURCES: return "OUT_OF_RESOURCES";
+    case ReturnCode_t::RETCODE_NOT_ENABLED: return "NOT_ENABLED";
+    case ReturnCode_t::RETCODE_TIMEOUT: return "TIMEOUT";
+    default: return "refused";
   }
 }
 
@@ -56,10 +91,14 @@ struct WriterBase::Listener final : dds::DataWriterListener {
 WriterBase::WriterBase(Context& ctx, const std::string& topic, dds::TopicDataType* support, const QosPreset& qos)
     : ctx_(ctx), qos_(qos), listener_(std::make_unique<Listener>()) {
   auto& t = ctx.topic(topic, support);
+  type_ = ctx.participant().find_type(t.get_type_name());
+  keyed_ = type_->m_isGetKeyDefined;
   counter_ = ctx.add_counter(topic, true);
   listener_->counter = counter_;
   dds::DataWriterQos wq = dds::DATAWRITER_QOS_DEFAULT;
-  apply(qos, wq);
+  apply(qos, keyed_, wq);
+  // Unregistering an instance disposes it too: readers learn the person left.
+  wq.writer_data_lifecycle().autodispose_unregistered_instances = true;
   // Reliable writers announce what they have every 200 ms (Fast DDS: 3 s), so a
   // sample lost on the wire is repaired within a fraction of a second: a lost
   // gesture event or sync tick must not wait seconds. Measured in tests/integration/lan.sh.
@@ -86,14 +125,87 @@ WriterBase::~WriterBase() {
   ctx_.publisher().delete_datawriter(writer_);
 }
 
-bool WriterBase::write(void* sample) {
-  const bool ok = writer_->write(sample);
-  if (ok) {
-    counter_->count.fetch_add(1, std::memory_order_relaxed);
-  } else {
-    counter_->dropped.fetch_add(1, std::memory_order_relaxed);
+void WriterBase::failed(const char* what, int return_code) {
+  counter_->dropped.fetch_add(1, std::memory_order_relaxed);
+  counter_->note_failure(std::string(what) + " " + return_code_name(return_code) +
+                         (keyed_ ? " with " + std::to_string(counter_->instances.load()) + " instance(s) alive" : std::string()));
+}
+
+bool WriterBase::write(void* sample, std::int64_t active_ns) {
+  std::map<InstanceId, Instance>::iterator it;
+  if (keyed_) {
+    eprosima::fastrtps::rtps::InstanceHandle_t h;
+    type_->getKey(sample, &h, false);
+    std::lock_guard<std::mutex> lock(mutex_);
+    it = instances_.find(to_id(h));
+    if (it == instances_.end()) {
+      // New here: registered, so that dispose_idle() can ask the writer for its key later.
+      const auto dds_handle = writer_->register_instance(sample);
+      if (!dds_handle.isDefined()) {
+        failed("write: a new instance", ReturnCode_t::RETCODE_OUT_OF_RESOURCES);
+        return false;
+      }
+      it = instances_.emplace(to_id(h), Instance{to_id(dds_handle), 0}).first;
+      counter_->instances.store(instances_.size(), std::memory_order_relaxed);
+    }
+    it->second.last_active_ns = active_ns == kNow ? Context::monotonic_ns() : active_ns;
   }
+  const auto rc = writer_->write(sample, eprosima::fastrtps::rtps::c_InstanceHandle_Unknown);
+  if (rc != ReturnCode_t::RETCODE_OK) {
+    failed("write", rc());
+    return false;
+  }
+  counter_->count.fetch_add(1, std::memory_order_relaxed);
+  return true;
+}
+
+bool WriterBase::unregister(void* key_holder, const Instance& instance) {
+  const auto rc = writer_->unregister_instance(key_holder, to_handle(instance.dds_handle));
+  if (rc != ReturnCode_t::RETCODE_OK) {
+    failed("dispose", rc());
+    return false;
+  }
+  return true;
+}
+
+bool WriterBase::dispose(void* sample) {
+  if (!keyed_) return false;
+  eprosima::fastrtps::rtps::InstanceHandle_t h;
+  type_->getKey(sample, &h, false);
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto it = instances_.find(to_id(h));
+  if (it == instances_.end()) return false;
+  const bool ok = unregister(sample, it->second);
+  instances_.erase(it);  // refused or not, this writer is done with it
+  counter_->instances.store(instances_.size(), std::memory_order_relaxed);
   return ok;
+}
+
+std::size_t WriterBase::dispose_idle(std::int64_t before_ns) {
+  if (!keyed_) return 0;
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::size_t n = 0;
+  void* key = nullptr;
+  for (auto it = instances_.begin(); it != instances_.end();) {
+    if (it->second.last_active_ns >= before_ns) {
+      ++it;
+      continue;
+    }
+    if (key == nullptr) key = type_->createData();
+    if (writer_->get_key_value(key, to_handle(it->second.dds_handle)) == ReturnCode_t::RETCODE_OK &&
+        unregister(key, it->second)) {
+      ++n;
+    }
+    it = instances_.erase(it);
+  }
+  if (key != nullptr) type_->deleteData(key);
+  counter_->instances.store(instances_.size(), std::memory_order_relaxed);
+  return n;
+}
+
+std::size_t WriterBase::live_instances() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return instances_.size();
 }
 
 std::size_t WriterBase::matched() const { return counter_->matched(); }
@@ -120,6 +232,7 @@ struct ReaderBase::State final : dds::DataReaderListener, std::enable_shared_fro
   dds::TypeSupport type;
   void* sample = nullptr;
   Deliver deliver;
+  Gone gone;
   std::shared_ptr<EndpointCounter> counter;
   std::atomic<bool> pending{false};
 
@@ -142,6 +255,12 @@ struct ReaderBase::State final : dds::DataReaderListener, std::enable_shared_fro
   }
   void on_sample_rejected(dds::DataReader*, const dds::SampleRejectedStatus& s) override {
     counter->dropped.fetch_add(static_cast<std::uint64_t>(s.total_count_change), std::memory_order_relaxed);
+    // Our reader had no room (resource limits): ours to fix, unlike a sample lost on the wire.
+    const char* why = s.last_reason == dds::REJECTED_BY_INSTANCES_LIMIT           ? "instance limit"
+                      : s.last_reason == dds::REJECTED_BY_SAMPLES_PER_INSTANCE_LIMIT ? "samples-per-instance limit"
+                      : s.last_reason == dds::REJECTED_BY_SAMPLES_LIMIT            ? "sample limit"
+                                                                                 : "rejected";
+    counter->note_failure(why);
   }
 
   void drain() {
@@ -150,16 +269,21 @@ struct ReaderBase::State final : dds::DataReaderListener, std::enable_shared_fro
     if (!alive || reader == nullptr) return;
     dds::SampleInfo info;
     while (reader->take_next_sample(sample, &info) == ReturnCode_t::RETCODE_OK) {
-      if (!info.valid_data) continue;
-      counter->count.fetch_add(1, std::memory_order_relaxed);
-      deliver(sample, SampleMeta{to_ns(info.source_timestamp), Context::now_ns()});
+      const SampleMeta meta{to_ns(info.source_timestamp), Context::now_ns(), to_id(info.instance_handle)};
+      if (!info.valid_data) {
+        // The writer disposed or unregistered the instance: it is gone.
+        if (gone && info.instance_state != dds::ALIVE_INSTANCE_STATE) gone(meta);
+      } else {
+        counter->count.fetch_add(1, std::memory_order_relaxed);
+        deliver(sample, meta);
+      }
       if (!alive) return;
     }
   }
 };
 
 ReaderBase::ReaderBase(Context& ctx, const std::string& topic, dds::TopicDataType* support, const QosPreset& qos,
-                       Deliver deliver)
+                       Deliver deliver, Gone gone)
     : state_(std::make_shared<State>()) {
   auto& t = ctx.topic(topic, support);
   state_->type = ctx.participant().find_type(t.get_type_name());
@@ -167,9 +291,10 @@ ReaderBase::ReaderBase(Context& ctx, const std::string& topic, dds::TopicDataTyp
   state_->executor = &ctx.executor();
   state_->subscriber = &ctx.subscriber();
   state_->deliver = std::move(deliver);
+  state_->gone = std::move(gone);
   state_->counter = ctx.add_counter(topic, false);
   dds::DataReaderQos rq = dds::DATAREADER_QOS_DEFAULT;
-  apply(qos, rq);
+  apply(qos, state_->type->m_isGetKeyDefined, rq);
   dds::StatusMask mask = dds::StatusMask::data_available();
   mask << dds::StatusMask::subscription_matched() << dds::StatusMask::sample_lost()
        << dds::StatusMask::sample_rejected();
@@ -203,9 +328,25 @@ std::shared_ptr<dds::TopicDataType> registered_raw_type(Context& ctx, const std:
   return ctx.participant().find_type(type_name);
 }
 
+namespace {
+// One of our own types is published typed, so that keyed samples are written
+// as their own instances (the raw type cannot see keys) and can be disposed.
+std::shared_ptr<dds::TopicDataType> publisher_type(Context& ctx, const std::string& topic, const std::string& type_name,
+                                                   bool keyed) {
+  const auto* known = msg::find_message(type_name);
+  if (known != nullptr && known->keyed == keyed && ctx.participant().find_type(type_name).empty()) {
+    auto* support = known->make_type_support();
+    apply_type_policy(*support);
+    ctx.topic(topic, support);
+    return ctx.participant().find_type(type_name);
+  }
+  return registered_raw_type(ctx, topic, type_name, keyed);
+}
+}  // namespace
+
 RawPublisher::RawPublisher(Context& ctx, const std::string& topic, const std::string& type_name, bool keyed,
                            const QosPreset& qos)
-    : type_(registered_raw_type(ctx, topic, type_name, keyed)),
+    : type_(publisher_type(ctx, topic, type_name, keyed)),
       base_(ctx, topic, new msg::RawPubSubType(type_name, keyed), qos) {
   if (dynamic_cast<msg::RawPubSubType*>(type_.get()) == nullptr) typed_ = type_->createData();
 }
@@ -214,8 +355,8 @@ RawPublisher::~RawPublisher() {
   if (typed_ != nullptr) type_->deleteData(typed_);
 }
 
-bool RawPublisher::publish(const msg::RawSample& sample) {
-  if (typed_ == nullptr) return base_.write(const_cast<msg::RawSample*>(&sample));
+bool RawPublisher::publish(const msg::RawSample& sample, std::int64_t active_ns) {
+  if (typed_ == nullptr) return base_.write(const_cast<msg::RawSample*>(&sample), active_ns);
   eprosima::fastrtps::rtps::SerializedPayload_t payload(static_cast<std::uint32_t>(sample.payload.size()));
   std::copy(sample.payload.begin(), sample.payload.end(), payload.data);
   payload.length = static_cast<std::uint32_t>(sample.payload.size());
@@ -225,7 +366,7 @@ bool RawPublisher::publish(const msg::RawSample& sample) {
   } catch (const std::exception&) {
     ok = false;
   }
-  return ok && base_.write(typed_);
+  return ok && base_.write(typed_, active_ns);
 }
 
 void RawSubscription::deliver(void* sample, const SampleMeta& m) {

@@ -245,6 +245,43 @@ void script_point(Builder& b, Rng& rng) {
 
 constexpr double kWalkRadius = 0.5;
 
+// shift: where the places are, and the doors the people come through
+// (outside every default sensor's view: on the diagonals, beyond 3 m).
+constexpr double kPlaceRadius = 0.7, kDoorRadius = 3.6;
+
+// A person at a place, facing the centre: reaching, holding, arms out,
+// picking from low down and resting, for `work` seconds.
+void script_work(Builder& b, double work) {
+  const BodyPose rest = b.cur;
+  const double end = b.t + work;
+  while (b.t < end - 1.0) {
+    const double u = b.rng.uniform();
+    BodyPose p = rest;
+    if (u < 0.3) {
+      const ArmPose reach{deg(b.rng.uniform(60.0, 95.0)), deg(b.rng.uniform(-10.0, 15.0)), b.rng.uniform(0.1, 0.6), 0.0};
+      p = with_arms(p, reach, reach);
+      b.to(p, b.rng.uniform(0.6, 1.0), "reach");
+      b.hold(b.rng.uniform(0.8, 2.0), "reach");
+    } else if (u < 0.5) {
+      const bool right = b.rng.chance(0.5);
+      (right ? p.right_arm : p.left_arm) = {deg(b.rng.uniform(70.0, 100.0)), deg(b.rng.uniform(40.0, 90.0)), 0.1, 0.0};
+      b.to(p, b.rng.uniform(0.6, 1.0), "hold_out");
+      b.hold(b.rng.uniform(0.8, 2.0), "hold_out");
+    } else if (u < 0.65) {
+      p.trunk_pitch = b.rng.uniform(0.4, 0.7);
+      const ArmPose low{b.rng.uniform(0.6, 0.9), 0.1, 0.2, 0.0};
+      p = with_arms(p, low, low);
+      b.to(p, b.rng.uniform(0.8, 1.2), "pick");
+      b.hold(b.rng.uniform(0.5, 1.0), "pick");
+    } else {
+      b.hold(b.rng.uniform(1.0, 3.0), "rest");
+      continue;
+    }
+    b.to(rest, b.rng.uniform(0.6, 1.0), "rest");
+  }
+  b.hold(std::max(0.2, end - b.t), "rest");
+}
+
 }  // namespace
 
 ArmPose arm_rest() { return {0.08, kPi / 2, 0.1, 0.0}; }
@@ -266,7 +303,7 @@ BodyPose interpolate(const BodyPose& a, const BodyPose& b, double u) {
 }
 
 const std::vector<std::string>& scenario_names() {
-  static const std::vector<std::string> names{"walk", "360", "hide", "box", "occ", "sit", "arms", "point"};
+  static const std::vector<std::string> names{"walk", "360", "hide", "box", "occ", "sit", "arms", "point", "shift"};
   return names;
 }
 
@@ -279,10 +316,16 @@ Scenario::Scenario(const ScenarioOptions& options) : opt_(options) {
   if (opt_.repeats < 1 || opt_.repeats > 1000) throw std::invalid_argument("scenario repeats must be 1-1000");
   if (opt_.people < 1 || opt_.people > 8) throw std::invalid_argument("scenario people must be 1-8");
 
+  if (!(opt_.work_s > 0.0 && opt_.work_s <= 3600.0)) throw std::invalid_argument("scenario work time must be 0-3600 s");
+
   Rng rng = Rng(opt_.seed).fork(0x5ce7a210);
   const BodyPose start = standing(heading_towards({0.0, 0.0}, opt_.facing));
-  Builder b{rng, keys_, start};
   keys_.push_back({0.0, start, "stand", false});
+  if (opt_.name == "shift") {
+    plan_shift(rng);
+    return;
+  }
+  Builder b{rng, keys_, start};
   const double hip_height = BodyDimensions::from_height(opt_.height).hip_height;
   for (int r = 0; r < opt_.repeats; ++r) {
     const auto& n = opt_.name;
@@ -310,23 +353,78 @@ Scenario::Scenario(const ScenarioOptions& options) : opt_(options) {
   duration_ = keys_.back().t;
 }
 
-BodyPose Scenario::script_pose(double t, std::string* phase) const {
-  const auto it = std::upper_bound(keys_.begin(), keys_.end(), t, [](double v, const Key& k) { return v < k.t; });
-  if (it == keys_.begin()) {
-    *phase = keys_.front().phase;
-    return keys_.front().pose;
+void Scenario::plan_shift(Rng& rng) {
+  const int places = opt_.people;
+  std::vector<Visit> visits;
+  for (int k = 0; k < places; ++k) {
+    const double a = kPi / 4 + 2 * kPi * k / places;
+    const Eigen::Vector2d dir(std::sin(a), std::cos(a));
+    const Eigen::Vector2d door = kDoorRadius * dir, place = kPlaceRadius * dir;
+    double t = rng.uniform(0.0, 6.0) + 2.0 * k;
+    for (int r = 0; r < opt_.repeats; ++r) {
+      Visit v;
+      v.slot = static_cast<std::size_t>(k);
+      v.enter = t;
+      const double speed = rng.uniform(1.0, 1.4);
+      const double walk = (door - place).norm() / speed;
+      BodyPose p = standing(heading_towards(door, place));
+      p.floor_position = door;
+      Builder b{rng, v.keys, p};
+      b.t = t;
+      v.keys.push_back({t, p, "walk_in", false});
+      p.floor_position = place;
+      b.cur = p;
+      b.t += walk;
+      v.keys.push_back({b.t, p, "walk_in", true});
+      script_work(b, rng.uniform(0.5, 1.5) * opt_.work_s);
+      p = b.cur;
+      p.heading += kPi;
+      b.to(p, 0.8, "turn");
+      p.floor_position = door;
+      b.cur = p;
+      b.t += walk;
+      v.keys.push_back({b.t, p, "walk_out", true});
+      v.leave = b.t;
+      visits.push_back(std::move(v));
+      t = b.t + rng.uniform(2.0, 8.0);
+    }
   }
-  if (it == keys_.end()) {
-    *phase = keys_.back().phase;
-    return keys_.back().pose;
+  std::sort(visits.begin(), visits.end(), [](const Visit& x, const Visit& y) { return x.enter < y.enter; });
+  for (std::size_t i = 0; i < visits.size(); ++i) visits[i].person_id = static_cast<std::uint32_t>(i + 1);
+  // The cell stays empty a while at the end, so that every departure can be seen.
+  for (const auto& v : visits) duration_ = std::max(duration_, v.leave + 6.0);
+  visits_ = std::move(visits);
+}
+
+namespace {
+// The pose at t along keys (clamped to their span), eased or linear per
+// segment; `blended`: between two keys rather than at an end.
+BodyPose pose_on(const std::vector<Scenario::Key>& keys, double t, std::string* phase, bool* blended) {
+  *blended = false;
+  const auto it = std::upper_bound(keys.begin(), keys.end(), t, [](double v, const Scenario::Key& k) { return v < k.t; });
+  if (it == keys.begin()) {
+    *phase = keys.front().phase;
+    return keys.front().pose;
   }
-  const Key& k0 = *(it - 1);
-  const Key& k1 = *it;
+  if (it == keys.end()) {
+    *phase = keys.back().phase;
+    return keys.back().pose;
+  }
+  const auto& k0 = *(it - 1);
+  const auto& k1 = *it;
   const double span = k1.t - k0.t;
   double u = span > 0 ? (t - k0.t) / span : 1.0;
   if (!k1.linear) u = smoothstep(u);
   *phase = k1.phase;
-  BodyPose p = interpolate(k0.pose, k1.pose, u);
+  *blended = true;
+  return interpolate(k0.pose, k1.pose, u);
+}
+}  // namespace
+
+BodyPose Scenario::script_pose(double t, std::string* phase) const {
+  bool blended = false;
+  BodyPose p = pose_on(keys_, t, phase, &blended);
+  if (!blended) return p;
   // Keyframes keep the feet on the floor; blends between them must too.
   const auto d = BodyDimensions::from_height(opt_.height);
   for (const auto* leg : {&p.left_leg, &p.right_leg}) {
@@ -368,6 +466,19 @@ Scene Scenario::at(double t) const {
   t = std::clamp(t, 0.0, duration_);
   Scene scene;
   scene.t = t;
+  if (opt_.name == "shift") {
+    for (const auto& v : visits_) {
+      if (t < v.enter || t >= v.leave) continue;
+      Actor a;
+      a.person_id = v.person_id;
+      a.slot = v.slot;
+      bool blended = false;
+      a.pose = pose_on(v.keys, t, &a.phase, &blended);
+      if (a.phase == "walk_in" || a.phase == "walk_out") gait(a.pose, 2 * kPi * 0.9 * t + static_cast<double>(v.slot));
+      scene.actors.push_back(a);
+    }
+    return scene;
+  }
   Actor first;
   first.person_id = 1;
   first.pose = script_pose(t, &first.phase);
@@ -382,6 +493,7 @@ Scene Scenario::at(double t) const {
   for (int k = 1; k < opt_.people; ++k) {
     Actor a;
     a.person_id = static_cast<std::uint32_t>(k + 1);
+    a.slot = static_cast<std::size_t>(k);
     const double angle = 2 * kPi * (t / 20.0 + static_cast<double>(k) / opt_.people) + 0.3;
     a.pose = standing();
     a.pose.floor_position = 1.3 * Eigen::Vector2d(std::sin(angle), std::cos(angle));

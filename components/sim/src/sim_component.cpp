@@ -17,6 +17,7 @@ void add_sim_params(runtime::ParamSchema& schema) {
       .add_int("seed", 1, "random seed: the same seed gives the same run, bit for bit", 0)
       .add_int("people", 1, "people in the cell (the others walk around it)", 1, 8)
       .add_double("height", 1.75, "body height of every person, m", 0.5, 2.5)
+      .add_double("work_s", 20.0, "shift: mean time each person works at a place, s", 1.0, 3600.0)
       .add_string("profile", "nite", "tracker model", TrackerProfile::names())
       .add_double("noise_scale", 1.0, "scale of the tracker's random errors (0: none)", 0.0, 10.0)
       .add_int("sensor_count", 2, "default sensors, 90 degrees apart around the cell (ignored when 'sensors' is set)", 1, 16)
@@ -40,6 +41,7 @@ SimConfig sim_config_from(const runtime::Params& params) {
   c.scenario.seed = static_cast<std::uint64_t>(params.get<std::int64_t>("seed"));
   c.scenario.people = static_cast<int>(params.get<std::int64_t>("people"));
   c.scenario.height = params.get<double>("height");
+  c.scenario.work_s = params.get<double>("work_s");
   c.profile = params.get<std::string>("profile");
   c.noise_scale = params.get<double>("noise_scale");
   c.truth_rate_hz = params.get<double>("truth_rate");
@@ -140,6 +142,7 @@ void SimComponent::on_start() {
   start_mono_ns_ = runtime::Context::monotonic_ns();
   config_.epoch_ns = runtime::Context::now_ns();
   config_.emit_frames = true;
+  config_.emit_departures = true;
   if (aligned_) {
     const auto period = static_cast<std::int64_t>(std::llround(sim_->duration() * 1e9 / rate_));
     const auto into = config_.epoch_ns % period;
@@ -160,7 +163,14 @@ void SimComponent::tick() {
       if (!publish_truth_) continue;
       truth_pub_.publish(skeleton::to_msg(e.skeleton));
       ++truth_published_;
+    } else if (e.kind == SimEvent::Kind::Left) {
+      // The person left the cell: readers of the truth see the instance disposed.
+      if (publish_truth_ && truth_pub_.dispose(skeleton::to_msg(e.skeleton))) ++departures_;
     } else if (!publishes(e.sensor)) {
+      continue;
+    } else if (e.kind == SimEvent::Kind::Lost) {
+      // The tracker dropped this user (a new one gets a new id): gone for every reader.
+      if (publish_raw_ && raw_pub_.dispose(skeleton::to_msg(e.skeleton))) ++users_lost_;
       continue;
     } else if (e.kind == SimEvent::Kind::Frame) {
       if (publish_raw_) {  // the heartbeat of the raw skeleton stream (a depth tracker sends its own)
@@ -220,6 +230,8 @@ nlohmann::json SimComponent::details() const {
           {"raw_published", raw_published_},
           {"depth_published", depth_published_},
           {"runs_completed", runs_completed_},
+          {"departures", departures_},
+          {"users_lost", users_lost_},
           {"finished", finished_.load()}};
 }
 
@@ -229,6 +241,7 @@ std::string SimComponent::summary() const {
      << truth_published_ << " truth and " << raw_published_ << " raw skeletons from " << config_.sensors.size()
      << " sensor(s)";
   if (depth_pub_) os << ", " << depth_published_ << " depth images";
+  if (departures_ > 0 || users_lost_ > 0) os << ", " << departures_ << " people left, " << users_lost_ << " tracker users lost";
   if (runs_completed_ > 0) os << ", " << runs_completed_ << " run(s) completed";
   return os.str();
 }

@@ -1,5 +1,6 @@
 #include "skelgraph/sim/simulation.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -11,7 +12,8 @@ struct Simulation::SensorState {
   std::size_t next = 0;
   std::uint32_t next_user_id = 1;
   std::uint64_t frame = 0;
-  std::vector<std::unique_ptr<TrackerModel>> trackers;  // one per person
+  std::vector<std::unique_ptr<TrackerModel>> trackers;  // one per place (Actor::slot)
+  std::vector<std::uint32_t> reported;                  // per tracker: the user it reported last frame (0 none)
 };
 
 Simulation::Simulation(SimConfig config)
@@ -36,6 +38,7 @@ Simulation::Simulation(SimConfig config)
                                                             cfg_.noise_scale, cfg_.scenario.height / 1.75,
                                                             &st->next_user_id));
     }
+    st->reported.assign(st->trackers.size(), 0);
     sensors_.push_back(std::move(st));
   }
 }
@@ -67,7 +70,24 @@ bool Simulation::finished() const {
 }
 
 void Simulation::emit_truth(double t, std::vector<SimEvent>& out) {
-  for (auto& s : truth_at(t)) {
+  auto truths = truth_at(t);
+  if (cfg_.emit_departures) {
+    std::vector<std::uint32_t> present;
+    for (const auto& s : truths) present.push_back(s.person_id);
+    for (const auto id : truth_present_) {
+      if (std::find(present.begin(), present.end(), id) != present.end()) continue;
+      SimEvent e;
+      e.kind = SimEvent::Kind::Left;
+      e.t = t;
+      e.actor = id;
+      e.skeleton.sensor_id = "truth";
+      e.skeleton.person_id = id;
+      e.skeleton.stamp_ns = cfg_.epoch_ns + std::llround(t * 1e9);
+      out.push_back(std::move(e));
+    }
+    truth_present_ = std::move(present);
+  }
+  for (auto& s : truths) {
     SimEvent e;
     e.kind = SimEvent::Kind::Truth;
     e.t = t;
@@ -86,14 +106,30 @@ void Simulation::emit_raw(std::size_t i, double t, std::vector<SimEvent>& out) {
   ++st.frame;
   std::uint32_t people = 0;
   for (std::size_t p = 0; p < st.trackers.size(); ++p) {
-    auto s = st.trackers[p]->observe(t, scene, p, truths);
+    // The person at this tracker's place, if anyone is there now.
+    std::size_t actor = 0;
+    while (actor < scene.actors.size() && scene.actors[actor].slot != p) ++actor;
+    auto s = st.trackers[p]->observe(t, scene, actor, truths);
+    const std::uint32_t user = s ? s->person_id : 0;
+    if (cfg_.emit_departures && st.reported[p] != 0 && st.reported[p] != user) {
+      SimEvent e;
+      e.kind = SimEvent::Kind::Lost;
+      e.t = t;
+      e.sensor = i;
+      e.skeleton.sensor_id = st.config.id;
+      e.skeleton.frame_id = st.config.id;
+      e.skeleton.person_id = st.reported[p];
+      e.skeleton.stamp_ns = sensor_stamp_ns(st.config, t, cfg_.epoch_ns);
+      out.push_back(std::move(e));
+    }
+    st.reported[p] = user;
     if (!s) continue;
     ++people;
     SimEvent e;
     e.kind = SimEvent::Kind::Raw;
     e.t = t;
     e.sensor = i;
-    e.actor = scene.actors[p].person_id;
+    e.actor = actor < scene.actors.size() ? scene.actors[actor].person_id : 0;
     s->stamp_ns = sensor_stamp_ns(st.config, t, cfg_.epoch_ns);
     s->frame_number = st.frame;
     e.skeleton = std::move(*s);

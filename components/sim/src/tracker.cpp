@@ -252,18 +252,8 @@ TrackerModel::TrackerModel(const TrackerProfile& profile, const SensorConfig& se
   for (auto& b : hidden_bias_) b.setZero();
 }
 
-std::optional<skeleton::Skeleton> TrackerModel::observe(double t, const Scene& scene, std::size_t actor,
-                                                        const std::vector<skeleton::Skeleton>& truths) {
-  const double dt = last_t_ < 0.0 ? 1.0 / view_.config().rate_hz : std::max(1e-4, t - last_t_);
-  const bool first_frame = last_t_ < 0.0;
-  last_t_ = t;
-  const auto& truth = truths[actor];
-  const BodyPose& pose = scene.actors[actor].pose;
-  const Visibility vis = visibility(view_, scene, actor, truths, body_scale_);
-  const double theta = view_.view_angle(pose);
-  const double back = std::clamp((theta - M_PI / 2) / (M_PI / 2), 0.0, 1.0);
-
-  // The correlated errors evolve whether or not anything is reported.
+// The correlated errors evolve whether or not anything is reported.
+void TrackerModel::evolve_errors(double dt, double back) {
   const double decay = dt / p_.bias_tau_s;
   for (std::size_t j = 0; j < kJointCount; ++j) {
     const double sd = (is_hand(skeleton::joint_at(j)) ? p_.hand_bias_sd : p_.bias_sd) * (1.0 + p_.back_bias_gain * back) *
@@ -273,6 +263,68 @@ std::optional<skeleton::Skeleton> TrackerModel::observe(double t, const Scene& s
     hidden_bias_[j] += -hidden_bias_[j] * decay +
                        p_.hidden_sd * noise_scale_ * kick * Vector3d(rng_.normal(), rng_.normal(), rng_.normal());
   }
+}
+
+std::optional<skeleton::Skeleton> TrackerModel::ghost(double dt, const Scene& scene) {
+  if (!last_report_) return std::nullopt;
+  // The last skeleton, where the person was, sliding onto the nearest prop.
+  Vector3d c = report_world_[idx(JointId::Torso)];
+  double best = 1.5;
+  Vector3d slide = Vector3d::Zero();
+  for (const auto& o : scene.obstacles) {
+    const Vector3d centre = o.box.center();
+    if ((centre - c).norm() < best) {
+      best = (centre - c).norm();
+      slide = centre - c;
+    }
+  }
+  ghost_on_prop_ = best < 1.5;
+  const double k = p_.contamination * (1.0 - std::exp(-dt / 0.7));
+  for (std::size_t j = 0; j < kJointCount; ++j) {
+    report_world_[j] += k * slide;
+    auto& joint = last_report_->joints[j];
+    joint.position = view_.to_sensor(report_world_[j]);
+    // A wall-shaped blob has a trunk but no arms to speak of.
+    const auto jid = skeleton::joint_at(j);
+    if (ghost_on_prop_ && is_arm(jid) && jid != JointId::LeftShoulder && jid != JointId::RightShoulder) {
+      joint.confidence = std::min(joint.confidence, skeleton::kInferred);
+    }
+  }
+  return last_report_;
+}
+
+// The person is not in the scene (gone from the cell): nothing in sight.
+std::optional<skeleton::Skeleton> TrackerModel::observe_nobody(double t, double dt, const Scene& scene) {
+  evolve_errors(dt, 0.0);
+  if (state_ == State::Tracking) {
+    state_ = State::Ghost;
+    lost_at_ = t;
+  }
+  if (state_ == State::Ghost && t - lost_at_ > (ghost_on_prop_ ? p_.ghost_on_prop_s : p_.ghost_s)) {
+    state_ = State::Searching;
+    sighted_since_ = -1.0;
+    last_report_.reset();
+  }
+  if (state_ == State::Searching) {
+    sighted_since_ = -1.0;
+    return std::nullopt;
+  }
+  return ghost(dt, scene);
+}
+
+std::optional<skeleton::Skeleton> TrackerModel::observe(double t, const Scene& scene, std::size_t actor,
+                                                        const std::vector<skeleton::Skeleton>& truths) {
+  const double dt = last_t_ < 0.0 ? 1.0 / view_.config().rate_hz : std::max(1e-4, t - last_t_);
+  const bool first_frame = last_t_ < 0.0;
+  last_t_ = t;
+  if (actor >= scene.actors.size()) return observe_nobody(t, dt, scene);
+  const auto& truth = truths[actor];
+  const BodyPose& pose = scene.actors[actor].pose;
+  const Visibility vis = visibility(view_, scene, actor, truths, body_scale_);
+  const double theta = view_.view_angle(pose);
+  const double back = std::clamp((theta - M_PI / 2) / (M_PI / 2), 0.0, 1.0);
+
+  evolve_errors(dt, back);
 
   // Finding and losing the person.
   const bool in_sight = vis.sighted_fraction >= p_.lose_fraction;
@@ -320,31 +372,7 @@ std::optional<skeleton::Skeleton> TrackerModel::observe(double t, const Scene& s
   }
   if (state_ == State::Ghost) {
     remember_truth();
-    if (!last_report_) return std::nullopt;
-    // The last skeleton, where the person was, sliding onto the nearest prop.
-    Vector3d c = report_world_[idx(JointId::Torso)];
-    double best = 1.5;
-    Vector3d slide = Vector3d::Zero();
-    for (const auto& o : scene.obstacles) {
-      const Vector3d centre = o.box.center();
-      if ((centre - c).norm() < best) {
-        best = (centre - c).norm();
-        slide = centre - c;
-      }
-    }
-    ghost_on_prop_ = best < 1.5;
-    const double k = p_.contamination * (1.0 - std::exp(-dt / 0.7));
-    for (std::size_t j = 0; j < kJointCount; ++j) {
-      report_world_[j] += k * slide;
-      auto& joint = last_report_->joints[j];
-      joint.position = view_.to_sensor(report_world_[j]);
-      // A wall-shaped blob has a trunk but no arms to speak of.
-      const auto jid = skeleton::joint_at(j);
-      if (ghost_on_prop_ && is_arm(jid) && jid != JointId::LeftShoulder && jid != JointId::RightShoulder) {
-        joint.confidence = std::min(joint.confidence, skeleton::kInferred);
-      }
-    }
-    return last_report_;
+    return ghost(dt, scene);
   }
 
   // Left/right flips with the back to the sensor.

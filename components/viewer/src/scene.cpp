@@ -54,6 +54,8 @@ void Scene::on_skeleton(const skeleton::Skeleton& s, std::int64_t now_ns) {
   skeletons_[{s.sensor_id, s.person_id}] = Held{std::move(world), kind, now_ns};
 }
 
+void Scene::on_gone(const std::string& sensor_id, std::uint32_t person_id) { skeletons_.erase({sensor_id, person_id}); }
+
 bool Scene::on_pose(const skeleton::SensorPose& p) {
   if (p.frame_id != "world") return false;
   poses_[p.sensor_id] = p;

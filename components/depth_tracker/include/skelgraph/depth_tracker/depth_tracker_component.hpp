@@ -31,6 +31,7 @@ class DepthTrackerComponent final : public runtime::Component {
  private:
   void on_depth(const msg::DepthFrame& frame);
   void on_depth_merged(depth::DepthImage image, std::int64_t receive_ns);
+  void dispose(const std::string& sensor, const std::vector<std::uint32_t>& people);
 
   struct Sensor {
     DepthTracker tracker;

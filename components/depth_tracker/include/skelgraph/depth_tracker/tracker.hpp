@@ -116,6 +116,9 @@ class DepthTracker {
                                                const std::vector<Eigen::Isometry3d>& world_from_sensor,
                                                const std::string& id = "merged");
 
+  // Ids of the people forgotten (not seen for lost_after_s) since the last call.
+  std::vector<std::uint32_t> take_dropped();
+
   const TrackerStats& stats() const;
   const TrackerOptions& options() const;
 

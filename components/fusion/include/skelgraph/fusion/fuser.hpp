@@ -53,6 +53,7 @@ struct FuserOptions {
 struct FuserStats {
   std::uint64_t added = 0, no_pose = 0, fused = 0, flips_corrected = 0, gated = 0;
   std::uint64_t tracks_merged = 0;  // a sensor's stream moved to an older track of the same person
+  std::uint64_t streams_ended = 0;  // remove(): a sensor's tracker said it lost a person
   // kalman: views left out because they disagreed with another sensor's and
   // lay in front of it along their own line of sight (on an occluder: a ghost)
   std::uint64_t occluded_views = 0;
@@ -75,6 +76,15 @@ class Fuser {
 
   // A raw skeleton in its sensor's frame, received at t_ns.
   void add(const skeleton::Skeleton& raw, std::int64_t t_ns);
+
+  // The sensor's tracker lost this person (its DDS instance was disposed):
+  // the stream ends now. A fused person left with no stream is gone at the
+  // next fuse(), without waiting for person_timeout_ns.
+  void remove(const std::string& sensor, std::uint32_t person_id);
+
+  // Fused person ids forgotten by fuse() since the last call (every sensor
+  // lost them, or none reported them for person_timeout_ns): they left.
+  std::vector<std::uint32_t> take_departed();
 
   // The fused skeleton of every person seen at t_ns (minus delay): world
   // frame, sensor_id "fused", stable person ids, joint sensor_mask bit i =

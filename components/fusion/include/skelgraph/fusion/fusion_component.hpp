@@ -5,7 +5,10 @@
 // (transient-local, so late joiners get them). A sensor silent for longer than
 // the timeout (no skeletons and no frames on skelgraph/sensor/frame) makes
 // the status DEGRADED; fusion goes on with the rest and takes
-// the sensor back when it returns. The Fuser core does the work.
+// the sensor back when it returns. A raw skeleton instance its source
+// disposes (the tracker lost the person) ends that stream at once; a fused
+// person with no stream left, or none for person_timeout_ms, is disposed on
+// skelgraph/skeleton/fused. The Fuser core does the work.
 
 #include <cstdint>
 #include <memory>
@@ -35,7 +38,7 @@ class FusionComponent final : public runtime::Component {
   std::int64_t period_ns_;
   bool on_ticks_;
   std::int64_t last_tick_ns_ = 0;  // when the last sync TICK drove a step
-  std::uint64_t steps_ = 0, published_ = 0, tick_steps_ = 0;
+  std::uint64_t steps_ = 0, published_ = 0, tick_steps_ = 0, departed_ = 0;
   std::set<std::string> silent_;
   std::uint64_t dropouts_ = 0, rejoins_ = 0;
   runtime::Publisher<msg::Skeleton> out_;

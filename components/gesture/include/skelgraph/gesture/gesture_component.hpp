@@ -4,7 +4,9 @@
 // sim --out`), one Spotter per person, and publishes each on
 // skelgraph/gesture/event (for pointing: the ray and where it meets the floor
 // or a configured surface) and each person's motion state on
-// skelgraph/gesture/state (on change and every second). Events are also
+// skelgraph/gesture/state (on change and every second). Every person of
+// the stream is watched at once; one whose skeleton instance is disposed
+// (they left) is forgotten at once and their state disposed. Events are also
 // logged, so `skelgraph launch` prints them.
 
 #include <cstdint>
@@ -36,15 +38,18 @@ class GestureComponent final : public runtime::Component {
     MotionState published = MotionState::Resting;
     bool ever_published = false;
   };
+  using People = std::map<std::pair<std::string, std::uint32_t>, Person>;  // (source, person id)
   void on_skeleton(const skeleton::Skeleton& s, std::int64_t receive_ns);
   void publish_state(const std::string& source, std::uint32_t person, const Person& p);
+  // The person left: their state instance is disposed.
+  People::iterator forget(People::iterator it);
 
   Classifier classifier_;
   SpotterOptions options_;
   std::int64_t person_timeout_ns_;
-  std::map<std::pair<std::string, std::uint32_t>, Person> people_;
+  People people_;
   std::map<std::string, std::uint64_t> events_by_label_;
-  std::uint64_t skeletons_ = 0, events_ = 0;
+  std::uint64_t skeletons_ = 0, events_ = 0, seen_ = 0, left_ = 0;
   runtime::Publisher<msg::GestureEvent> event_pub_;
   runtime::Publisher<msg::GestureState> state_pub_;
   runtime::Subscription<msg::Skeleton> sub_;

@@ -30,6 +30,7 @@ class Playback final : public runtime::Component {
   runtime::Publisher<msg::Skeleton> pub_;
   runtime::TimerHandle timer_;
   std::int64_t start_mono_ns_ = 0;
+  std::int64_t gone_after_ns_ = 1'000'000'000;
   std::int64_t start_stamp_ns_ = 0;
 };
 

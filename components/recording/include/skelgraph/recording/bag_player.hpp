@@ -56,6 +56,7 @@ class BagPlayer final : public runtime::Component {
   void wait_for_readers();
   // One pass from `from` (log time); messages before it: state topics published at once, others skipped.
   void play_once(std::uint64_t from);
+  void dispose_idle(std::int64_t before_log_ns);
   // Sleeps until `log_time` is due on the playback clock (paused: until resumed or
   // stepped); throws Stopped when asked to stop, SeekTo when asked to seek.
   void wait_until_due(std::uint64_t log_time);
@@ -68,6 +69,8 @@ class BagPlayer final : public runtime::Component {
   bool hold_at_end_;
   std::int64_t wait_ns_;
   std::uint64_t reorder_ns_;
+  std::int64_t gone_after_ns_;
+  std::uint64_t last_idle_check_ = 0;  // log time of the last dispose_idle (player thread)
   mcap::Reader reader_;
   std::uint64_t first_log_time_ = 0;
   std::uint64_t per_pass_ = 0;  // messages selected for playback in one pass

@@ -33,7 +33,18 @@ struct EndpointCounter {
   std::string topic;
   bool is_output = false;
   std::atomic<std::uint64_t> count{0};
-  std::atomic<std::uint64_t> dropped{0};
+  std::atomic<std::uint64_t> dropped{0};    // outputs: writes DDS refused; inputs: samples rejected or lost
+  std::atomic<std::uint64_t> instances{0};  // keyed outputs: instances written and not yet disposed
+
+  // Something this component did failed here (a write DDS refused, a sample
+  // our reader had no room for): the component is DEGRADED while it is recent.
+  void note_failure(const std::string& what);
+  struct Failures {
+    std::uint64_t count = 0;
+    std::int64_t last_mono_ns = 0;
+    std::string last;  // what the last one was
+  };
+  Failures failures() const;
 
   // Remote endpoints currently matched (set from DDS listener threads).
   void set_matched(int n);
@@ -44,6 +55,7 @@ struct EndpointCounter {
   mutable std::mutex mutex_;
   mutable std::condition_variable cv_;
   std::size_t matched_ = 0;
+  Failures failures_;
 };
 
 enum class HealthState { Ok, Degraded, Error };
@@ -98,9 +110,12 @@ class Context {
   };
   std::vector<Unauthenticated> unauthenticated(std::chrono::milliseconds after);
 
-  // The component's health, reported on skelgraph/status.
+  // The component's health, reported on skelgraph/status: what it set,
+  // made DEGRADED by failures of its endpoints (EndpointCounter::note_failure)
+  // within the last `failure_window` (the whole run: the launcher's final report).
   void set_health(HealthState state, std::string message);
-  std::pair<HealthState, std::string> health() const;
+  std::pair<HealthState, std::string> health(std::chrono::nanoseconds failure_window = kFailureWindow) const;
+  static constexpr std::chrono::nanoseconds kFailureWindow = std::chrono::seconds(10);
 
  private:
   std::string name_;

@@ -45,6 +45,11 @@ struct LaunchSpec {
 LaunchSpec parse_launch_file(const std::string& path);
 LaunchSpec parse_launch_text(const std::string& text, const std::string& source);
 
+// Sets parameters from the command line, each "COMPONENT.KEY=VALUE" (a list
+// value as "a,b"), over what the file says; checked with the rest by
+// resolve_launch. Throws LaunchError for a malformed one or an unknown component.
+void set_launch_params(LaunchSpec& spec, const std::vector<std::string>& assignments);
+
 struct ResolvedComponent {
   std::string name;
   std::string kind;

@@ -11,10 +11,20 @@ namespace skelgraph::runtime {
 enum class Reliability { BestEffort, Reliable };
 enum class Durability { Volatile, TransientLocal };
 
+// Every endpoint sets its resource limits from this, never Fast DDS's
+// defaults (10 instances per writer and reader: the 10th person of a cell
+// was refused). Keyed topics: at most `max_instances` instances alive at once
+// in a writer or reader; writers dispose an instance when its person, sensor
+// or component is gone, which frees it. Samples: `depth` per instance (keep
+// last), or kKeepAllSamples per instance (keep all).
 struct QosPreset {
   Reliability reliability = Reliability::Reliable;
   Durability durability = Durability::Volatile;
   int depth = 0;  // history depth per instance; 0 = keep all
+  int max_instances = kDefaultInstances;  // keyed types only (an unkeyed topic is one instance)
+
+  static constexpr int kDefaultInstances = 256;  // topics outside the table (tools reading foreign topics)
+  static constexpr int kKeepAllSamples = 5000;   // per instance, keep-all topics (a reliable writer then blocks)
 };
 
 // A reader that only shows the newest samples (a display) asks for best
@@ -44,28 +54,29 @@ inline const TopicDef<msg::SyncCommand> kSync{"skelgraph/sync", {R::Reliable, D:
 inline const TopicDef<msg::SyncCommand> kSyncSession{"skelgraph/sync/session", {R::Reliable, D::TransientLocal, 1}};
 // Requests to the sync master (skelgraph sync start|stop, robots).
 inline const TopicDef<msg::SyncControl> kSyncControl{"skelgraph/sync/control", {R::Reliable, D::Volatile, 0}};
-inline const TopicDef<msg::SyncAck> kSyncAck{"skelgraph/sync_ack", {R::Reliable, D::Volatile, 0}};
+inline const TopicDef<msg::SyncAck> kSyncAck{"skelgraph/sync_ack", {R::Reliable, D::Volatile, 0, 256}};
 // Each host's clock offset, from the sync master; late joiners (recorders) get the latest per host.
-inline const TopicDef<msg::ClockOffset> kSyncClock{"skelgraph/sync/clock", {R::Reliable, D::TransientLocal, 32}};
-inline const TopicDef<msg::Skeleton> kSkeletonRaw{"skelgraph/skeleton/raw", {R::BestEffort, D::Volatile, 5}};
+inline const TopicDef<msg::ClockOffset> kSyncClock{"skelgraph/sync/clock", {R::Reliable, D::TransientLocal, 32, 64}};
+inline const TopicDef<msg::Skeleton> kSkeletonRaw{"skelgraph/skeleton/raw", {R::BestEffort, D::Volatile, 5, 1024}};
 // One per delivered sensor frame (people seen or not): the sensor is alive.
-inline const TopicDef<msg::SensorFrame> kSensorFrame{"skelgraph/sensor/frame", {R::BestEffort, D::Volatile, 5}};
-inline const TopicDef<msg::Skeleton> kSkeletonFused{"skelgraph/skeleton/fused", {R::BestEffort, D::Volatile, 5}};
-inline const TopicDef<msg::Skeleton> kSkeletonTruth{"skelgraph/skeleton/truth", {R::Reliable, D::Volatile, 64}};
-inline const TopicDef<msg::DepthFrame> kDepth{"skelgraph/depth", {R::BestEffort, D::Volatile, 2}};
+inline const TopicDef<msg::SensorFrame> kSensorFrame{"skelgraph/sensor/frame", {R::BestEffort, D::Volatile, 5, 64}};
+inline const TopicDef<msg::Skeleton> kSkeletonFused{"skelgraph/skeleton/fused", {R::BestEffort, D::Volatile, 5, 256}};
+inline const TopicDef<msg::Skeleton> kSkeletonTruth{"skelgraph/skeleton/truth", {R::Reliable, D::Volatile, 64, 256}};
+inline const TopicDef<msg::DepthFrame> kDepth{"skelgraph/depth", {R::BestEffort, D::Volatile, 2, 64}};
 // Keyed by sensor; the depth keeps every sensor's latest pose for readers
 // that do not know the key (generic tools such as `topic echo`).
-inline const TopicDef<msg::SensorPose> kCalibration{"skelgraph/calibration", {R::Reliable, D::TransientLocal, 32}};
+inline const TopicDef<msg::SensorPose> kCalibration{"skelgraph/calibration", {R::Reliable, D::TransientLocal, 32, 64}};
 inline const TopicDef<msg::GestureEvent> kGestureEvent{"skelgraph/gesture/event", {R::Reliable, D::Volatile, 0}};
-// Keyed by person in spirit: the latest state of each person reaches late joiners.
-inline const TopicDef<msg::GestureState> kGestureState{"skelgraph/gesture/state", {R::Reliable, D::TransientLocal, 16}};
+// Keyed by (source, person): the latest states of each person reach late
+// joiners; disposed when the person leaves.
+inline const TopicDef<msg::GestureState> kGestureState{"skelgraph/gesture/state", {R::Reliable, D::TransientLocal, 16, 256}};
 // Thinned point clouds for viewers (the `cloud` component): the latest only.
-inline const TopicDef<msg::PointCloud> kCloud{"skelgraph/cloud", {R::BestEffort, D::Volatile, 1}};
+inline const TopicDef<msg::PointCloud> kCloud{"skelgraph/cloud", {R::BestEffort, D::Volatile, 1, 64}};
 // Requests to players of recordings (skelgraph play ...), and each player's
 // state (keyed by player; late joiners get the latest).
 inline const TopicDef<msg::PlayControl> kPlayControl{"skelgraph/play/control", {R::Reliable, D::Volatile, 0}};
-inline const TopicDef<msg::PlayState> kPlayState{"skelgraph/play/state", {R::Reliable, D::TransientLocal, 16}};
-inline const TopicDef<msg::ComponentStatus> kStatus{"skelgraph/status", {R::BestEffort, D::Volatile, 1}};
+inline const TopicDef<msg::PlayState> kPlayState{"skelgraph/play/state", {R::Reliable, D::TransientLocal, 16, 64}};
+inline const TopicDef<msg::ComponentStatus> kStatus{"skelgraph/status", {R::BestEffort, D::Volatile, 1, 256}};
 
 }  // namespace topics
 

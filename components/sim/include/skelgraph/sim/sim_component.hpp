@@ -51,6 +51,7 @@ class SimComponent final : public runtime::Component {
   bool publishes(std::size_t sensor) const;
   double loop_offset_s_ = 0.0;  // world time at which the current run started
   std::uint64_t truth_published_ = 0, raw_published_ = 0, depth_published_ = 0, runs_completed_ = 0;
+  std::uint64_t departures_ = 0, users_lost_ = 0;  // truth and raw instances disposed
   std::atomic<bool> finished_{false};
 };
 

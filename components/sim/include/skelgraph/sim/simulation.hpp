@@ -25,10 +25,14 @@ struct SimConfig {
   double truth_rate_hz = 30.0;
   std::int64_t epoch_ns = 0;     // world clock at t = 0
   bool emit_frames = false;      // also a Frame event for every sensor frame (seen anyone or not)
+  bool emit_departures = false;  // also Lost and Left events (when a tracker drops a user, a person leaves)
 };
 
 struct SimEvent {
-  enum class Kind { Truth, Raw, Frame };
+  // Lost: sensor's tracker no longer reports user skeleton.person_id (at this
+  // frame of it; before its Raw events). Left: the person skeleton.person_id
+  // is no longer in the scene (truth; before this truth frame's events).
+  enum class Kind { Truth, Raw, Frame, Lost, Left };
   Kind kind = Kind::Truth;
   double t = 0.0;                  // world time, s since the start
   std::size_t sensor = 0;          // Raw: index into the configuration's sensors
@@ -66,6 +70,7 @@ class Simulation {
   BodyDimensions body_;
   std::vector<std::unique_ptr<SensorState>> sensors_;
   std::uint64_t truth_frame_ = 0;
+  std::vector<std::uint32_t> truth_present_;  // people in the last truth frame (emit_departures)
 };
 
 }  // namespace skelgraph::sim

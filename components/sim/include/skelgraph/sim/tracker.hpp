@@ -80,7 +80,8 @@ class TrackerModel {
                double body_scale, std::uint32_t* next_user_id);
 
   // One frame at world time t: the skeleton in the sensor frame, or nothing
-  // when the tracker has no user for this person.
+  // when the tracker has no user for this person. `actor` out of range: the
+  // person is not in the scene (left the cell).
   std::optional<skeleton::Skeleton> observe(double t, const Scene& scene, std::size_t actor,
                                             const std::vector<skeleton::Skeleton>& truths);
 
@@ -88,6 +89,9 @@ class TrackerModel {
 
  private:
   enum class State { Searching, Tracking, Ghost };
+  void evolve_errors(double dt, double back);
+  std::optional<skeleton::Skeleton> ghost(double dt, const Scene& scene);
+  std::optional<skeleton::Skeleton> observe_nobody(double t, double dt, const Scene& scene);
   struct Flicker {
     bool on = false;
     void step(double p, double dwell, double dt, Rng& rng);

@@ -44,6 +44,8 @@ class Scene {
   explicit Scene(SceneOptions options = {});
 
   void on_skeleton(const skeleton::Skeleton& s, std::int64_t now_ns);
+  // The stream's writer disposed this person (they left): no longer drawn.
+  void on_gone(const std::string& sensor_id, std::uint32_t person_id);
   // A pose in a frame other than "world" is ignored (returns false).
   bool on_pose(const skeleton::SensorPose& p);
   // Any JSON object (the adapter converts GestureEvent, ComponentStatus, PlayState).

@@ -31,6 +31,7 @@ class ViewerComponent final : public runtime::Component {
 
  private:
   void on_skeleton(const msg::Skeleton& m, std::int64_t now_ns);
+  void on_gone(const msg::Skeleton& last);
   std::string on_client_message(const std::string& text, bool& bad);
 
   Scene scene_;
