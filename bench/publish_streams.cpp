@@ -53,13 +53,13 @@ int main(int argc, char** argv) {
     for (int i = 0; i < skeletons; ++i) {
       s.sensor_id("sensor" + std::to_string(i + 1));
       s.frame_number(k);
-      s.stamp_ns(runtime::Context::now_ns());
+      s.stamp_ns(runtime::system_clock()->now_ns());
       if (skel.publish(s)) ++n_skel; else ++failed;
     }
     for (int i = 0; i < depths; ++i) {
       frame.sensor_id("depth" + std::to_string(i + 1));
       frame.frame_number(k);
-      frame.stamp_ns(runtime::Context::now_ns());
+      frame.stamp_ns(runtime::system_clock()->now_ns());
       if (depth.publish(frame)) ++n_depth; else ++failed;
     }
   }

@@ -51,7 +51,7 @@ TEST(Playback, ReplaysAGenericCsvAsALiveStream) {
   // Best effort: the writer may match the reader before the reader matches the
   // writer, and frames sent in between are lost (a clean-clone run got 26 of 30).
   ASSERT_TRUE(sub.wait_for_matched(1, 10s));
-  const auto before = Context::now_ns();
+  const auto before = system_clock()->now_ns();
   graph.start();
   ASSERT_TRUE(got.wait_count(30, 20s)) << got.items().size() << " of 30 frames";
   graph.stop();

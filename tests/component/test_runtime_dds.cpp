@@ -217,7 +217,7 @@ TEST(RuntimeDds, DisposeIdleEndsInstancesNotWrittenSince) {
     ASSERT_TRUE(pub.publish(s));
   }
   ASSERT_TRUE(b.executor().run_sync([] {}, 5s));
-  const auto cut = Context::monotonic_ns();
+  const auto cut = a.clock().monotonic_ns();
   s.person_id(2);
   // Written again after the cut: stays. (Best effort: the reader must have it
   // alive before the others' disposal, so write until it has.)
@@ -260,6 +260,31 @@ TEST(RuntimeDds, FailedWriteMakesTheComponentDegraded) {
   // Still DEGRADED for a while after the failure, and for the whole run in the final report.
   EXPECT_EQ(a.health().first, HealthState::Degraded);
   EXPECT_EQ(a.health(std::chrono::nanoseconds(0)).first, HealthState::Ok);
+}
+
+// The clock is the context's (injected through the configuration): receive
+// stamps come from it, so a test can drive a component's time by hand.
+TEST(RuntimeDds, ReceiveStampsComeFromTheContextsClock) {
+  auto config = test::test_config();
+  auto fake = std::make_shared<FakeClock>(1'000'000'000);
+  config.clock = fake;
+  Context a("clock_writer", test::test_config());
+  Context b("clock_reader", config);
+  EXPECT_EQ(b.clock().now_ns(), 1'000'000'000);
+  test::Collector<std::int64_t> got;
+  Subscription<msg::SyncCommand> sub(b, topics::kSync, [&](const msg::SyncCommand&, const SampleMeta& m) { got.add(m.receive_ns); });
+  Publisher<msg::SyncCommand> pub(a, topics::kSync);
+  b.executor().start();
+  ASSERT_TRUE(pub.wait_for_matched(1, 10s));
+  fake->set(5'000'000'000);
+  ASSERT_TRUE(pub.publish(msg::SyncCommand{}));
+  ASSERT_TRUE(got.wait_count(1));
+  EXPECT_EQ(got.items()[0], 5'000'000'000);
+  // Another host's clock: the wall clock shifted, the monotonic one not.
+  const OffsetClock ahead(system_clock(), 250'000'000);
+  const auto wall = system_clock()->now_ns();
+  EXPECT_NEAR(static_cast<double>(ahead.now_ns() - wall), 250e6, 50e6);
+  EXPECT_NEAR(static_cast<double>(ahead.monotonic_ns() - system_clock()->monotonic_ns()), 0.0, 50e6);
 }
 
 TEST(RuntimeDds, TopicBoundToOneType) {

@@ -10,7 +10,7 @@ source "$(dirname "$0")/lib.sh"
 sim=$!
 "$SKELGRAPH" bag record --dir "$WORK/rec" --host hostA --duration 40 --json >"$WORK/a.json" 2>"$WORK/a.err" &
 a=$!
-SKELGRAPH_CLOCK_SKEW_NS=250000000 "$SKELGRAPH" bag record --dir "$WORK/rec" --host hostB --duration 40 --json >"$WORK/b.json" 2>"$WORK/b.err" &
+"$SKELGRAPH" bag record --clock-offset-ms 250 --dir "$WORK/rec" --host hostB --duration 40 --json >"$WORK/b.json" 2>"$WORK/b.err" &
 b=$!
 "$SKELGRAPH" run sync_master -p autostart=false --name sync --duration 40 --json >"$WORK/sync.json" 2>"$WORK/sync.err" &
 sync=$!

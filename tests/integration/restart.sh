@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # A component started over inside a running launch (what `skelgraph launch`
 # does when its secure participant is stuck in authentication, Fast DDS 2.9;
-# docs/security.md), forced here with the test hook SKELGRAPH_TEST_AUTH_STALL
+# docs/security.md), forced here with `launch --test-auth-stall`
 # on the loopback profile: the recorder restarts once with a new participant,
 # rejoins the running session, and its first file is kept (the second part
 # goes to <label>_<session>_<host>_2.mcap); both parts merge into one session.
@@ -19,9 +19,9 @@ components:
       directory: $WORK/rec
       host: hostA
 YAML
-SKELGRAPH_TEST_AUTH_STALL=recorder@3 "$SKELGRAPH" launch "$WORK/graph.yaml" --duration 8 --json \
+"$SKELGRAPH" launch "$WORK/graph.yaml" --test-auth-stall recorder@3 --duration 8 --json \
   >"$WORK/launch.json" 2>"$WORK/launch.err" || fail "launch: $(tail -5 "$WORK/launch.err")"
-grep -q "recorder: restarting it with a new DDS participant: 'test' (SKELGRAPH_TEST_AUTH_STALL)" "$WORK/launch.err" ||
+grep -q "recorder: restarting it with a new DDS participant: 'test' (simulated)" "$WORK/launch.err" ||
   fail "no restart: $(cat "$WORK/launch.err")"
 [ "$(grep -c "restarting it" "$WORK/launch.err")" -eq 1 ] || fail "restarted more than once: $(cat "$WORK/launch.err")"
 json_check "$WORK/launch.json" 'all(c["state"] == "OK" for c in d["components"])'

@@ -36,8 +36,8 @@ int main(int argc, char** argv) {
   e.target_name("floor");
   const int count = static_cast<int>(seconds * 2);
   for (int i = 0; i < count; ++i) {
-    e.start_stamp_ns(runtime::Context::now_ns() - 500'000'000);
-    e.end_stamp_ns(runtime::Context::now_ns());
+    e.start_stamp_ns(runtime::system_clock()->now_ns() - 500'000'000);
+    e.end_stamp_ns(runtime::system_clock()->now_ns());
     pub.publish(e);
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
   }

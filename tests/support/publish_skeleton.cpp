@@ -83,7 +83,7 @@ int run(double duration_s) {
   std::uint64_t n = 0;
   while (!stop_requested.load() && std::chrono::steady_clock::now() < end) {
     sample.frame_number(n);
-    sample.stamp_ns(runtime::Context::now_ns());
+    sample.stamp_ns(runtime::system_clock()->now_ns());
     pub.publish(sample);
     ++n;
     next += period;

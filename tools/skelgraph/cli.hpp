@@ -26,6 +26,7 @@ struct GlobalOptions {
   std::vector<std::string> interfaces;
   std::vector<std::string> discovery_servers;
   std::optional<std::string> security_dir;
+  double clock_offset_ms = 0.0;  // this process plays a host whose clock is off by this much (tests)
   std::string log_level = "info";
 };
 

@@ -153,7 +153,7 @@ int hz(const runtime::DdsConfig& config, const std::string& topic, double window
   std::mutex mutex;
   const auto window_ns = static_cast<std::int64_t>(window_s * 1e9);
   runtime::RateStats stats(window_ns);
-  auto mono_ns = [] { return runtime::Context::monotonic_ns(); };
+  auto mono_ns = [] { return runtime::system_clock()->monotonic_ns(); };
   std::int64_t first_ns = 0;
   runtime::RawSubscription sub(*s.context, topic, plan.type_name, plan.keyed, plan.qos,
                                [&](const msg::RawSample&, const runtime::SampleMeta&) {

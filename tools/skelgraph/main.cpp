@@ -33,6 +33,9 @@ runtime::DdsConfig make_config(const GlobalOptions& g, const runtime::LaunchSpec
     for (const auto& a : g.discovery_servers) runtime::parse_server_address(a);
     c.discovery_servers = g.discovery_servers;
   }
+  if (g.clock_offset_ms != 0.0) {
+    c.clock = std::make_shared<runtime::OffsetClock>(runtime::system_clock(), static_cast<std::int64_t>(g.clock_offset_ms * 1e6));
+  }
   return c;
 }
 
@@ -92,6 +95,9 @@ void add_dds_options(CLI::App& cmd, GlobalOptions& g) {
                  "lan-discovery-server profile; env SKELGRAPH_DISCOVERY_SERVERS)");
   cmd.add_option("--security", g.security_dir,
                  "DDS Security credentials from `skelgraph security init` (secure profile; env SKELGRAPH_SECURITY_DIR)");
+  cmd.add_option("--clock-offset-ms", g.clock_offset_ms,
+                 "run this process on a wall clock this far ahead (negative: behind): plays a host whose clock is off, "
+                 "to test clock-offset estimation on one machine");
 }
 
 void block_signals() {

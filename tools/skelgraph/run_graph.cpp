@@ -26,6 +26,10 @@ void add_run_options(CLI::App& cmd, RunOptions& options) {
   cmd.add_option("--status-every", options.status_every_s, "print each component's status line every S seconds")
       ->check(kNonNegative);
   cmd.add_flag("--json", options.json, "print the final report as JSON on stdout");
+  cmd.add_option("--test-auth-stall", options.auth_stall,
+                 "NAME@SECONDS: component NAME counts as stuck in DDS Security authentication that long after its "
+                 "start, once, so that its restart can be tested without a cell that hits the Fast DDS defect")
+      ->group("");  // hidden: for tests
 }
 
 int run_components(GlobalOptions& g, const std::vector<ComponentRun>& list, const RunOptions& options,
@@ -58,6 +62,17 @@ int run_graph(const runtime::ComponentRegistry& registry, const runtime::DdsConf
               const std::vector<runtime::ResolvedComponent>& components, const RunOptions& options,
               const std::function<void(runtime::Graph&, nlohmann::json&)>& extra_report) {
   runtime::Graph graph(registry, config);
+  if (!options.auth_stall.empty()) {
+    const auto at = options.auth_stall.find('@');
+    double secs = 0;
+    try {
+      secs = at == std::string::npos ? -1 : std::stod(options.auth_stall.substr(at + 1));
+    } catch (const std::exception&) {
+      secs = -1;
+    }
+    if (at == 0 || secs < 0) throw UsageError("--test-auth-stall " + options.auth_stall + ": expected NAME@SECONDS");
+    graph.simulate_auth_stall(options.auth_stall.substr(0, at), std::chrono::nanoseconds(static_cast<std::int64_t>(secs * 1e9)));
+  }
   graph.add_all(components);
   graph.start();
   for (const auto& c : components) {

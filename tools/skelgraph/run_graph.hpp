@@ -22,6 +22,7 @@ struct RunOptions {
   double duration_s = 0.0;      // 0: until a signal
   double status_every_s = 0.0;  // 0: only at start and end
   bool json = false;            // final report as JSON on stdout
+  std::string auth_stall;       // "NAME@SECONDS": component NAME counts as stuck in authentication then (tests of the restart)
 };
 
 // Adds --duration, --status-every and --json to a command that runs a graph.

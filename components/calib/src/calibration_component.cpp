@@ -33,7 +33,7 @@ class CalibrationComponent final : public runtime::Component {
 
   void on_start() override {
     for (auto p : file_.sensors) {
-      p.stamp_ns = runtime::Context::now_ns();
+      p.stamp_ns = ctx_.clock().now_ns();
       pub_.publish(skeleton::to_msg(p));
       ++published_;
     }

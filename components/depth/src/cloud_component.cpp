@@ -92,7 +92,7 @@ void CloudComponent::on_depth(const msg::DepthFrame& frame, std::int64_t receive
 }
 
 void CloudComponent::publish() {
-  const auto now = runtime::Context::now_ns();
+  const auto now = ctx_.clock().now_ns();
   const auto fresh = static_cast<std::int64_t>(std::max(0.2, 2 * period_s_) * 1e9);
   std::vector<msg::PointCloud> out;
   {

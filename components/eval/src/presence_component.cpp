@@ -76,7 +76,7 @@ class PresenceComponent final : public runtime::Component {
 
   void on_start() override {
     timer_ = ctx_.executor().every(std::chrono::milliseconds(100), [this] {
-      const auto now = runtime::Context::now_ns();
+      const auto now = ctx_.clock().now_ns();
       with([&] { core_.sample(now); });
     });
   }

@@ -77,7 +77,7 @@ FusionComponent::FusionComponent(runtime::Context& ctx, const runtime::Params& p
 
 void FusionComponent::on_start() {
   timer_ = ctx_.executor().every(std::chrono::nanoseconds(period_ns_), [this] {
-    const auto now = runtime::Context::now_ns();
+    const auto now = ctx_.clock().now_ns();
     // Ticks drive the output while they come; the timer takes over when they stop.
     if (on_ticks_ && last_tick_ns_ != 0 && now - last_tick_ns_ < 3 * period_ns_) {
       update_health(now);

@@ -103,7 +103,7 @@ GestureComponent::GestureComponent(runtime::Context& ctx, const runtime::Params&
 
 void GestureComponent::on_start() {
   timer_ = ctx_.executor().every(std::chrono::seconds(1), [this] {
-    const auto now = runtime::Context::now_ns();
+    const auto now = ctx_.clock().now_ns();
     for (auto it = people_.begin(); it != people_.end();) {
       if (now - it->second.last_seen_ns > person_timeout_ns_) {
         it = forget(it);

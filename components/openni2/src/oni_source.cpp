@@ -12,10 +12,6 @@ namespace skelgraph::openni2 {
 
 namespace {
 
-std::int64_t host_now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
 
 // OpenNI::initialize/shutdown are reference counted; one pair per source.
 void initialize_openni() {
@@ -233,24 +229,24 @@ std::optional<depth::DepthImage> OniSource::next(std::chrono::milliseconds timeo
   ++frames_this_pass_;
   image.frame_number = frames_read_;
   if (!file) {
-    image.stamp_ns = host_now_ns();
+    image.stamp_ns = opt_.clock->now_ns();
     if (recording()) ++recorded_;
     return image;
   }
   // Recordings: the recorded timing, scaled by the speed, from the first
   // frame (or the first since the speed changed or pacing restarted).
   if (repace_) {
-    pace_start_ns_ = host_now_ns();
+    pace_start_ns_ = opt_.clock->now_ns();
     pace_first_ts_us_ = ts;
     repace_ = false;
   }
   const std::int64_t since_us = static_cast<std::int64_t>(ts - pace_first_ts_us_);
   if (opt_.speed > 0) {
     image.stamp_ns = pace_start_ns_ + static_cast<std::int64_t>(std::llround(since_us * 1000.0 / opt_.speed));
-    const auto wait_ns = image.stamp_ns - host_now_ns();
+    const auto wait_ns = image.stamp_ns - opt_.clock->now_ns();
     if (wait_ns > 0) std::this_thread::sleep_for(std::chrono::nanoseconds(wait_ns));
   } else {
-    image.stamp_ns = host_now_ns();
+    image.stamp_ns = opt_.clock->now_ns();
   }
   return image;
 }

@@ -40,6 +40,7 @@ OpenNI2Component::OpenNI2Component(runtime::Context& ctx, const runtime::Params&
   options_.width = static_cast<int>(params.get<std::int64_t>("width"));
   options_.height = static_cast<int>(params.get<std::int64_t>("height"));
   options_.fps = static_cast<int>(params.get<std::int64_t>("fps"));
+  options_.clock = ctx.clock_ptr();
   record_dir_ = params.get<std::string>("record_directory");
   source_ = std::make_unique<OniSource>(options_);
   finite_ = source_->is_file() && !options_.repeat;

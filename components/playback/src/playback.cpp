@@ -48,13 +48,13 @@ Playback::Playback(runtime::Context& ctx, const runtime::Params& params)
 }
 
 void Playback::on_start() {
-  start_mono_ns_ = runtime::Context::monotonic_ns();
-  start_stamp_ns_ = runtime::Context::now_ns();
+  start_mono_ns_ = ctx_.clock().monotonic_ns();
+  start_stamp_ns_ = ctx_.clock().now_ns();
   timer_ = ctx_.executor().every(std::chrono::milliseconds(2), [this] { tick(); }, true);
 }
 
 void Playback::tick() {
-  const auto now = runtime::Context::monotonic_ns();
+  const auto now = ctx_.clock().monotonic_ns();
   for (const auto& s : schedule_->due(now - start_mono_ns_, start_stamp_ns_)) pub_.publish(skeleton::to_msg(s));
   // A data set says nothing of people leaving; one missing for a while has.
   pub_.dispose_idle(schedule_->finished() ? now + 1 : now - gone_after_ns_);

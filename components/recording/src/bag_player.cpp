@@ -157,11 +157,11 @@ void BagPlayer::run() {
 // Best-effort samples written before discovery matched a reader are lost: wait for readers first.
 // A writer matches a reader before that reader has matched the writer; give the other side 0.5 s more.
 void BagPlayer::wait_for_readers() {
-  const auto t0 = runtime::Context::monotonic_ns();
+  const auto t0 = ctx_.clock().monotonic_ns();
   std::int64_t matched_at = 0;
   std::unique_lock lock(mutex_);
   while (!stop_) {
-    const auto now = runtime::Context::monotonic_ns();
+    const auto now = ctx_.clock().monotonic_ns();
     const bool all = std::all_of(publishers_.begin(), publishers_.end(), [](const auto& p) { return p->matched() > 0; });
     if (all && matched_at == 0) matched_at = now;
     if ((matched_at != 0 && now - matched_at >= 500'000'000) || now - t0 >= wait_ns_) return;
@@ -191,7 +191,7 @@ void BagPlayer::wait_until_due(std::uint64_t log_time) {
       player_->wait_for_request(std::chrono::milliseconds(50));
       continue;
     }
-    const auto now = runtime::Context::monotonic_ns();
+    const auto now = ctx_.clock().monotonic_ns();
     if (repace || pace_mono_ == 0) {
       pace_mono_ = now;
       pace_log_ = log_time;
@@ -233,7 +233,7 @@ void BagPlayer::play_once(std::uint64_t from) {
     }
     position_log_ = t;
     player_->delivered();
-    const auto now = runtime::Context::monotonic_ns();
+    const auto now = ctx_.clock().monotonic_ns();
     if (now - last_state_ns_ >= 250'000'000) {
       last_state_ns_ = now;
       player_->publish_state();

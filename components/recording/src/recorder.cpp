@@ -64,11 +64,11 @@ Recorder::Recorder(runtime::Context& ctx, const runtime::Params& params)
 }
 
 void Recorder::on_start() {
-  if (record_now_) open(now_label_, static_cast<std::uint32_t>(runtime::Context::now_ns() / 1'000'000'000));
+  if (record_now_) open(now_label_, static_cast<std::uint32_t>(ctx_.clock().now_ns() / 1'000'000'000));
   flush_timer_ = ctx_.executor().every(std::chrono::milliseconds(100), [this] {
     if (!session_) return;
     try {
-      session_->maybe_flush(runtime::Context::now_ns());
+      session_->maybe_flush(ctx_.clock().now_ns());
     } catch (const std::exception& e) {
       fail(e.what());
     }
@@ -92,7 +92,7 @@ void Recorder::open(const std::string& label, std::uint32_t session_id) {
   close();
   session_id_ = session_id;
   try {
-    session_ = std::make_unique<SessionRecorder>(options_, label, session_id, runtime::Context::now_ns());
+    session_ = std::make_unique<SessionRecorder>(options_, label, session_id, ctx_.clock().now_ns());
   } catch (const std::exception& e) {
     last_error_ = e.what();
     ctx_.set_health(runtime::HealthState::Error, "cannot record session " + std::to_string(session_id) + ": " + last_error_);
@@ -129,7 +129,7 @@ void Recorder::close() {
   linger_timer_active_ = false;
   if (!session_) return;
   try {
-    session_->finish(runtime::Context::now_ns());
+    session_->finish(ctx_.clock().now_ns());
     finished_.push_back({{"file", session_->path()}, {"messages", session_->messages()}, {"counts", session_->counts()}});
     ctx_.set_health(runtime::HealthState::Ok, "wrote " + session_->path());
   } catch (const std::exception& e) {
@@ -190,7 +190,7 @@ void Recorder::on_sample(const runtime::TopicInfo& topic, bool keyed, const msg:
     ack.tick(sync->tick());
     ack.master_stamp_ns(sync->master_stamp_ns());
     ack.receive_stamp_ns(m.receive_ns);
-    ack.send_stamp_ns(runtime::Context::now_ns());
+    ack.send_stamp_ns(ctx_.clock().now_ns());
     ack_pub_.publish(ack);
     ++ticks_acked_;
   } else if (sync->kind() == msg::SYNC_STOP && !record_now_) {

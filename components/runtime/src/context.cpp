@@ -41,7 +41,8 @@ namespace rtps = eprosima::fastrtps::rtps;
 // listener. A refusal is printed (a stranger, or a certificate of another CA).
 class AuthWatch final : public dds::DomainParticipantListener {
  public:
-  AuthWatch(std::string self, dds::DomainParticipantListener* next) : self_(std::move(self)), next_(next) {}
+  AuthWatch(std::string self, dds::DomainParticipantListener* next, std::shared_ptr<const Clock> clock)
+      : self_(std::move(self)), next_(next), clock_(std::move(clock)) {}
 
   void on_participant_discovery(dds::DomainParticipant* p, rtps::ParticipantDiscoveryInfo&& info) override {
     {
@@ -50,7 +51,7 @@ class AuthWatch final : public dds::DomainParticipantListener {
       if (info.status == rtps::ParticipantDiscoveryInfo::DISCOVERED_PARTICIPANT) {
         names_[key] = info.info.m_participantName.to_string();
         if (!info.info.identity_token_.is_nil() && !done_.count(key)) {
-          pending_.emplace(key, Pending{names_[key], Context::monotonic_ns()});
+          pending_.emplace(key, Pending{names_[key], clock_->monotonic_ns()});
         }
       } else if (info.status != rtps::ParticipantDiscoveryInfo::CHANGED_QOS_PARTICIPANT) {
         const auto it = pending_.find(key);
@@ -89,7 +90,7 @@ class AuthWatch final : public dds::DomainParticipantListener {
 
   std::vector<Context::Unauthenticated> stalled(std::int64_t older_than_ns) {
     std::vector<Context::Unauthenticated> out;
-    const auto now = Context::monotonic_ns();
+    const auto now = clock_->monotonic_ns();
     std::lock_guard<std::mutex> lock(mutex_);
     for (auto& [key, p] : pending_) {
       if (now - p.since_ns <= older_than_ns) continue;
@@ -118,6 +119,7 @@ class AuthWatch final : public dds::DomainParticipantListener {
   }
   std::string self_;
   dds::DomainParticipantListener* next_;
+  std::shared_ptr<const Clock> clock_;
   mutable std::mutex mutex_;
   std::map<std::string, Pending> pending_;
   std::set<std::string> done_;
@@ -181,7 +183,7 @@ bool apply_security(dds::DomainParticipantQos& qos, const DdsConfig& config, con
 }  // namespace
 
 Context::Context(std::string name, const DdsConfig& config, dds::DomainParticipantListener* listener)
-    : name_(std::move(name)), config_(config), executor_(name_) {
+    : name_(std::move(name)), config_(config), clock_(config.clock ? config.clock : system_clock()), executor_(name_) {
   executor_.on_error([this](const std::string& what) {
     std::fprintf(stderr, "%s: unhandled error in a callback: %s\n", name_.c_str(), what.c_str());
     set_health(HealthState::Error, "unhandled error: " + what);
@@ -230,7 +232,7 @@ Context::Context(std::string name, const DdsConfig& config, dds::DomainParticipa
                              "SKELGRAPH_DISCOVERY_SERVERS (start one with `fastdds discovery -i 0 -l IP -p PORT`)");
   }
   const bool secure = apply_security(qos, config, profile);
-  if (secure) auth_watch_ = std::make_unique<AuthWatch>(name_, listener);
+  if (secure) auth_watch_ = std::make_unique<AuthWatch>(name_, listener, clock_);
   participant_ = factory->create_participant(static_cast<dds::DomainId_t>(config.domain), qos,
                                              secure ? auth_watch_.get() : listener, dds::StatusMask::none());
   if (participant_ == nullptr) {
@@ -252,29 +254,12 @@ Context::~Context() {
   }
 }
 
-std::int64_t Context::now_ns() {
-  // SKELGRAPH_CLOCK_SKEW_NS shifts this process's clock, so tests on one
-  // machine can play hosts whose clocks disagree (tests/integration/two_hosts.sh).
-  static const std::int64_t skew = [] {
-    const char* s = std::getenv("SKELGRAPH_CLOCK_SKEW_NS");
-    return s != nullptr ? std::strtoll(s, nullptr, 10) : 0LL;
-  }();
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-             .count() +
-         skew;
-}
 
 std::vector<Context::Unauthenticated> Context::unauthenticated(std::chrono::milliseconds after) {
   if (!auth_watch_) return {};
   return auth_watch_->stalled(std::chrono::duration_cast<std::chrono::nanoseconds>(after).count());
 }
 
-std::int64_t Context::monotonic_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
 
 dds::Publisher& Context::publisher() {
   std::lock_guard<std::mutex> lock(mutex_);
@@ -384,7 +369,7 @@ std::pair<HealthState, std::string> Context::health(std::chrono::nanoseconds fai
   std::lock_guard<std::mutex> lock(mutex_);
   auto state = health_;
   auto message = health_message_;
-  const auto now = monotonic_ns();
+  const auto now = clock_->monotonic_ns();
   for (const auto& c : counters_) {
     const auto f = c->failures();
     if (f.count == 0 || now - f.last_mono_ns > failure_window.count()) continue;
@@ -398,10 +383,10 @@ std::pair<HealthState, std::string> Context::health(std::chrono::nanoseconds fai
   return {state, message};
 }
 
-void EndpointCounter::note_failure(const std::string& what) {
+void EndpointCounter::note_failure(const std::string& what, std::int64_t mono_ns) {
   std::lock_guard<std::mutex> lock(mutex_);
   ++failures_.count;
-  failures_.last_mono_ns = Context::monotonic_ns();
+  failures_.last_mono_ns = mono_ns;
   failures_.last = what;
 }
 

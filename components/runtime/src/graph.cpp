@@ -1,7 +1,6 @@
 #include "skelgraph/runtime/graph.hpp"
 
 #include <cstdio>
-#include <cstdlib>
 #include <map>
 #include <set>
 #include <sstream>
@@ -26,21 +25,6 @@ msg::ComponentState to_msg(HealthState s) {
 }
 const char* to_text(HealthState s) { return msg::to_string(to_msg(s)); }
 
-// SKELGRAPH_TEST_AUTH_STALL=NAME@SECONDS: a test hook (like
-// SKELGRAPH_CLOCK_SKEW_NS) that makes heal() treat component NAME as stuck in
-// authentication SECONDS after its start, once, so the restart can be tested
-// without a secure cell that happens to hit the Fast DDS defect.
-std::pair<std::string, std::int64_t> test_stall() {
-  static const auto v = [] {
-    const char* e = std::getenv("SKELGRAPH_TEST_AUTH_STALL");
-    if (e == nullptr) return std::pair<std::string, std::int64_t>{};
-    const std::string s(e);
-    const auto at = s.find('@');
-    const double secs = at == std::string::npos ? 20.0 : std::atof(s.c_str() + at + 1);
-    return std::pair<std::string, std::int64_t>{s.substr(0, at), static_cast<std::int64_t>(secs * 1e9)};
-  }();
-  return v;
-}
 }  // namespace
 
 // Members are destroyed bottom-up: the component first, then the status
@@ -71,7 +55,7 @@ struct Graph::Node {
     s.component_name(context->name());
     s.kind(kind);
     s.host(context->config().host);
-    const auto now = Context::now_ns();
+    const auto now = context->clock().now_ns();
     s.stamp_ns(now);
     const auto [state, message] = context->health();
     s.state(to_msg(state));
@@ -105,6 +89,11 @@ Graph::~Graph() {
   while (!nodes_.empty()) nodes_.pop_back();
 }
 
+void Graph::simulate_auth_stall(std::string name, std::chrono::nanoseconds after) {
+  stall_name_ = std::move(name);
+  stall_after_ns_ = after.count();
+}
+
 Component& Graph::add(const std::string& name, const std::string& kind, const Params& params) {
   if (started_) throw std::logic_error("Graph::add after start");
   for (const auto& n : nodes_) {
@@ -123,7 +112,7 @@ Component& Graph::add(const std::string& name, const std::string& kind, const Pa
 
 void Graph::build(Node& node) {
   node.context = std::make_unique<Context>(node.name, config_);
-  node.created_ns = Context::monotonic_ns();
+  node.created_ns = node.context->clock().monotonic_ns();
   node.status = std::make_unique<Publisher<msg::ComponentStatus>>(*node.context, topics::kStatus);
   try {
     node.component = registry_.find(node.kind)->factory(*node.context, node.params);
@@ -164,9 +153,9 @@ std::vector<std::string> Graph::heal(std::chrono::milliseconds stall, int max_re
     for (const auto& p : node->context->unauthenticated(stall)) {
       if (p.since_ns - node->created_ns <= stall_ns / 2 || p.again) stuck.push_back(p.who);
     }
-    if (const auto fake = test_stall(); node->restarts == 0 && fake.first == node->name &&
-                                        Context::monotonic_ns() - node->created_ns > fake.second) {
-      stuck.push_back("'test' (SKELGRAPH_TEST_AUTH_STALL)");
+    if (node->restarts == 0 && !stall_name_.empty() && stall_name_ == node->name &&
+        node->context->clock().monotonic_ns() - node->created_ns > stall_after_ns_) {
+      stuck.push_back("'test' (simulated)");
     }
     if (stuck.empty()) continue;
     std::string who;

@@ -128,7 +128,8 @@ WriterBase::~WriterBase() {
 void WriterBase::failed(const char* what, int return_code) {
   counter_->dropped.fetch_add(1, std::memory_order_relaxed);
   counter_->note_failure(std::string(what) + " " + return_code_name(return_code) +
-                         (keyed_ ? " with " + std::to_string(counter_->instances.load()) + " instance(s) alive" : std::string()));
+                             (keyed_ ? " with " + std::to_string(counter_->instances.load()) + " instance(s) alive" : std::string()),
+                         ctx_.clock().monotonic_ns());
 }
 
 bool WriterBase::write(void* sample, std::int64_t active_ns) {
@@ -148,7 +149,7 @@ bool WriterBase::write(void* sample, std::int64_t active_ns) {
       it = instances_.emplace(to_id(h), Instance{to_id(dds_handle), 0}).first;
       counter_->instances.store(instances_.size(), std::memory_order_relaxed);
     }
-    it->second.last_active_ns = active_ns == kNow ? Context::monotonic_ns() : active_ns;
+    it->second.last_active_ns = active_ns == kNow ? ctx_.clock().monotonic_ns() : active_ns;
   }
   const auto rc = writer_->write(sample, eprosima::fastrtps::rtps::c_InstanceHandle_Unknown);
   if (rc != ReturnCode_t::RETCODE_OK) {
@@ -233,6 +234,7 @@ struct ReaderBase::State final : dds::DataReaderListener, std::enable_shared_fro
   void* sample = nullptr;
   Deliver deliver;
   Gone gone;
+  std::shared_ptr<const Clock> clock;
   std::shared_ptr<EndpointCounter> counter;
   std::atomic<bool> pending{false};
 
@@ -260,7 +262,7 @@ struct ReaderBase::State final : dds::DataReaderListener, std::enable_shared_fro
                       : s.last_reason == dds::REJECTED_BY_SAMPLES_PER_INSTANCE_LIMIT ? "samples-per-instance limit"
                       : s.last_reason == dds::REJECTED_BY_SAMPLES_LIMIT            ? "sample limit"
                                                                                  : "rejected";
-    counter->note_failure(why);
+    counter->note_failure(why, clock->monotonic_ns());
   }
 
   void drain() {
@@ -269,7 +271,7 @@ struct ReaderBase::State final : dds::DataReaderListener, std::enable_shared_fro
     if (!alive || reader == nullptr) return;
     dds::SampleInfo info;
     while (reader->take_next_sample(sample, &info) == ReturnCode_t::RETCODE_OK) {
-      const SampleMeta meta{to_ns(info.source_timestamp), Context::now_ns(), to_id(info.instance_handle)};
+      const SampleMeta meta{to_ns(info.source_timestamp), clock->now_ns(), to_id(info.instance_handle)};
       if (!info.valid_data) {
         // The writer disposed or unregistered the instance: it is gone.
         if (gone && info.instance_state != dds::ALIVE_INSTANCE_STATE) gone(meta);
@@ -292,6 +294,7 @@ ReaderBase::ReaderBase(Context& ctx, const std::string& topic, dds::TopicDataTyp
   state_->subscriber = &ctx.subscriber();
   state_->deliver = std::move(deliver);
   state_->gone = std::move(gone);
+  state_->clock = ctx.clock_ptr();
   state_->counter = ctx.add_counter(topic, false);
   dds::DataReaderQos rq = dds::DATAREADER_QOS_DEFAULT;
   apply(qos, state_->type->m_isGetKeyDefined, rq);

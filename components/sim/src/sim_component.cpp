@@ -139,8 +139,8 @@ void SimComponent::publish_poses() {
 }
 
 void SimComponent::on_start() {
-  start_mono_ns_ = runtime::Context::monotonic_ns();
-  config_.epoch_ns = runtime::Context::now_ns();
+  start_mono_ns_ = ctx_.clock().monotonic_ns();
+  config_.epoch_ns = ctx_.clock().now_ns();
   config_.emit_frames = true;
   config_.emit_departures = true;
   if (aligned_) {
@@ -156,7 +156,7 @@ void SimComponent::on_start() {
 }
 
 void SimComponent::tick() {
-  const double t = static_cast<double>(runtime::Context::monotonic_ns() - start_mono_ns_) * 1e-9 * rate_ - loop_offset_s_;
+  const double t = static_cast<double>(ctx_.clock().monotonic_ns() - start_mono_ns_) * 1e-9 * rate_ - loop_offset_s_;
   for (const auto& e : sim_->advance(t)) {
     if (e.t + loop_offset_s_ < skip_before_s_) continue;
     if (e.kind == SimEvent::Kind::Truth) {

@@ -70,13 +70,13 @@ void SyncMaster::on_ack(const msg::SyncAck& a, const runtime::SampleMeta& m) {
   clock.published_ns = m.receive_ns;
 }
 
-std::int64_t SyncMaster::mono_ns() { return runtime::Context::monotonic_ns(); }
+std::int64_t SyncMaster::mono_ns() const { return ctx_.clock().monotonic_ns(); }
 
 void SyncMaster::start_session(const std::string& label, const std::string& request_id) {
   // The timer starts with the session, so each firing finds exactly one tick due.
-  publish(core_.start(label, mono_ns(), runtime::Context::now_ns(), request_id));
+  publish(core_.start(label, mono_ns(), ctx_.clock().now_ns(), request_id));
   timer_ = ctx_.executor().every(std::chrono::nanoseconds(core_.config().tick_period_ns), [this] {
-    publish(core_.advance(mono_ns(), runtime::Context::now_ns()));
+    publish(core_.advance(mono_ns(), ctx_.clock().now_ns()));
     if (!core_.running()) timer_.cancel();  // the session's duration ran out
   });
 }
@@ -87,7 +87,7 @@ void SyncMaster::on_start() {
 
 void SyncMaster::on_shutdown() {
   timer_.cancel();
-  publish(core_.stop(runtime::Context::now_ns()));
+  publish(core_.stop(ctx_.clock().now_ns()));
 }
 
 void SyncMaster::on_control(const msg::SyncControl& c) {
@@ -102,7 +102,7 @@ void SyncMaster::on_control(const msg::SyncControl& c) {
   } else if (c.kind() == msg::SYNC_STOP) {
     spdlog::info("{}: STOP requested by {}", ctx_.name(), c.requester().to_string());
     timer_.cancel();
-    publish(core_.stop(runtime::Context::now_ns(), c.request_id().to_string()));
+    publish(core_.stop(ctx_.clock().now_ns(), c.request_id().to_string()));
   }
 }
 

@@ -36,7 +36,6 @@ SceneOptions scene_options(const runtime::Params& p) {
   o.far_m = p.get<double>("far_m");
   return o;
 }
-std::int64_t now() { return runtime::Context::monotonic_ns(); }
 }  // namespace
 
 ViewerComponent::ViewerComponent(runtime::Context& ctx, const runtime::Params& params)
@@ -45,16 +44,16 @@ ViewerComponent::ViewerComponent(runtime::Context& ctx, const runtime::Params& p
       address_(params.get<std::string>("address")),
       period_ns_(static_cast<std::int64_t>(1e9 / params.get<double>("rate_hz"))),
       play_pub_(ctx, runtime::topics::kPlayControl),
-      raw_sub_(ctx, runtime::topics::kSkeletonRaw, [this](const msg::Skeleton& m, const runtime::SampleMeta&) { on_skeleton(m, now()); },
+      raw_sub_(ctx, runtime::topics::kSkeletonRaw, [this](const msg::Skeleton& m, const runtime::SampleMeta&) { on_skeleton(m, now_mono()); },
                [this](const msg::Skeleton& m, const runtime::SampleMeta&) { on_gone(m); }),
-      fused_sub_(ctx, runtime::topics::kSkeletonFused, [this](const msg::Skeleton& m, const runtime::SampleMeta&) { on_skeleton(m, now()); },
+      fused_sub_(ctx, runtime::topics::kSkeletonFused, [this](const msg::Skeleton& m, const runtime::SampleMeta&) { on_skeleton(m, now_mono()); },
                  [this](const msg::Skeleton& m, const runtime::SampleMeta&) { on_gone(m); }),
       // The viewer draws the newest truth only. (Reliable, this was the stream
       // missing from the page in 3 clean-clone test runs, stops 20, 24 and 27:
       // nothing received in-process for the whole run while another process
       // read it; the cause in Fast DDS 2.9 was not found.)
       truth_sub_(ctx, runtime::topics::kSkeletonTruth, runtime::newest_only(runtime::topics::kSkeletonTruth.qos),
-                 [this](const msg::Skeleton& m, const runtime::SampleMeta&) { on_skeleton(m, now()); },
+                 [this](const msg::Skeleton& m, const runtime::SampleMeta&) { on_skeleton(m, now_mono()); },
                  [this](const msg::Skeleton& m, const runtime::SampleMeta&) { on_gone(m); }),
       pose_sub_(ctx, runtime::topics::kCalibration,
                 [this](const msg::SensorPose& m, const runtime::SampleMeta&) {
@@ -63,10 +62,10 @@ ViewerComponent::ViewerComponent(runtime::Context& ctx, const runtime::Params& p
                                  m.sensor_id().to_string(), m.frame_id().to_string());
                 }),
       gesture_sub_(ctx, runtime::topics::kGestureEvent,
-                   [this](const msg::GestureEvent& e, const runtime::SampleMeta&) { scene_.on_gesture(e, now()); }),
+                   [this](const msg::GestureEvent& e, const runtime::SampleMeta&) { scene_.on_gesture(e, now_mono()); }),
       status_sub_(ctx, runtime::topics::kStatus,
                   [this](const msg::ComponentStatus& s, const runtime::SampleMeta&) {
-                    scene_.on_status(s.component_name().to_string(), s, now());
+                    scene_.on_status(s.component_name().to_string(), s, now_mono());
                   }),
       play_state_sub_(ctx, runtime::topics::kPlayState,
                       [this](const msg::PlayState& s, const runtime::SampleMeta&) { scene_.on_player(s.player().to_string(), s); }) {
@@ -91,7 +90,7 @@ std::string ViewerComponent::url() const {
 void ViewerComponent::on_start() {
   spdlog::info("{}: open {} in a browser", ctx_.name(), url());
   timer_ = ctx_.executor().every(std::chrono::nanoseconds(period_ns_), [this] {
-    const auto t = now();
+    const auto t = now_mono();
     auto frame = scene_.frame(t);
     frame["viewer"] = ctx_.name();
     frame["made_ns"] = t;  // CLOCK_MONOTONIC of this host: delays measured by clients on it

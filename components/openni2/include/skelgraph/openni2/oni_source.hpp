@@ -22,6 +22,7 @@
 #include <optional>
 #include <string>
 
+#include "skelgraph/runtime/clock.hpp"
 #include "skelgraph/depth/depth_image.hpp"
 
 namespace skelgraph::openni2 {
@@ -35,6 +36,8 @@ struct OniOptions {
   // Devices: the depth mode to ask for (0: the device's default); one it does
   // not offer is an error listing the modes it does.
   int width = 0, height = 0, fps = 0;
+  // Frames are stamped (and recordings paced) on this clock's wall time.
+  std::shared_ptr<const runtime::Clock> clock = runtime::system_clock();
 };
 
 class OniSource {

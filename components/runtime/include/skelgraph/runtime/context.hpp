@@ -38,7 +38,7 @@ struct EndpointCounter {
 
   // Something this component did failed here (a write DDS refused, a sample
   // our reader had no room for): the component is DEGRADED while it is recent.
-  void note_failure(const std::string& what);
+  void note_failure(const std::string& what, std::int64_t mono_ns);
   struct Failures {
     std::uint64_t count = 0;
     std::int64_t last_mono_ns = 0;
@@ -77,11 +77,10 @@ class Context {
   Executor& executor() { return executor_; }
   eprosima::fastdds::dds::DomainParticipant& participant() { return *participant_; }
 
-  // Wall-clock time in ns since the Unix epoch: message stamps (plus
-  // SKELGRAPH_CLOCK_SKEW_NS when set: a test hook to play a host with another clock).
-  static std::int64_t now_ns();
-  // Monotonic time in ns (arbitrary origin): pacing and intervals.
-  static std::int64_t monotonic_ns();
+  // The component's clock (the configuration's): now_ns() for message
+  // stamps, monotonic_ns() for pacing and intervals.
+  const Clock& clock() const { return *clock_; }
+  const std::shared_ptr<const Clock>& clock_ptr() const { return clock_; }
 
   // Shared DDS entities, created on first use.
   eprosima::fastdds::dds::Publisher& publisher();
@@ -120,6 +119,7 @@ class Context {
  private:
   std::string name_;
   DdsConfig config_;
+  std::shared_ptr<const Clock> clock_;
   std::unique_ptr<AuthWatch> auth_watch_;  // the participant's listener when secure: outlives it
   eprosima::fastdds::dds::DomainParticipant* participant_ = nullptr;
   eprosima::fastdds::dds::Publisher* publisher_ = nullptr;

@@ -1,8 +1,11 @@
 #pragma once
 // How a process joins DDS: which XML profile, which domain, which interfaces.
 
+#include <memory>
 #include <string>
 #include <vector>
+
+#include "skelgraph/runtime/clock.hpp"
 
 namespace skelgraph::runtime {
 
@@ -24,6 +27,8 @@ struct DdsConfig {
   std::string security_dir;
   // Reported in status messages and sync acks; the identity under security.
   std::string host;
+  // The clock of every component made with this configuration (Context::clock()).
+  std::shared_ptr<const Clock> clock = system_clock();
 
   // Defaults from the environment: SKELGRAPH_PROFILE, SKELGRAPH_DOMAIN,
   // SKELGRAPH_INTERFACES (comma-separated), SKELGRAPH_DISCOVERY_SERVERS

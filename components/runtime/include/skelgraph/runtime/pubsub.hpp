@@ -44,7 +44,7 @@ class WriterBase {
   WriterBase& operator=(const WriterBase&) = delete;
   // False when DDS refuses it: counted, and the component is DEGRADED for a
   // while. Keyed: `active_ns` is when the instance was last active, on a
-  // clock of the caller's (default: Context::monotonic_ns()), for dispose_idle().
+  // clock of the caller's (default: the context's monotonic clock), for dispose_idle().
   static constexpr std::int64_t kNow = INT64_MIN;
   bool write(void* sample, std::int64_t active_ns = kNow);
   // Keyed topics: the writer disposes and unregisters the sample's instance

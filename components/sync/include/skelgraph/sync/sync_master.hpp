@@ -31,7 +31,7 @@ class SyncMaster final : public runtime::Component {
   void publish(const std::vector<SyncEvent>& events);
   void on_control(const msg::SyncControl& c);
   void on_ack(const msg::SyncAck& a, const runtime::SampleMeta& m);
-  static std::int64_t mono_ns();
+  std::int64_t mono_ns() const;
 
   SyncMasterCore core_;
   bool autostart_;

@@ -32,6 +32,7 @@ class ViewerComponent final : public runtime::Component {
  private:
   void on_skeleton(const msg::Skeleton& m, std::int64_t now_ns);
   void on_gone(const msg::Skeleton& last);
+  std::int64_t now_mono() const { return ctx_.clock().monotonic_ns(); }  // the scene's time
   std::string on_client_message(const std::string& text, bool& bad);
 
   Scene scene_;
