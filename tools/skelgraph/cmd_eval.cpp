@@ -29,6 +29,7 @@
 #include "run_graph.hpp"
 #include "skelgraph/calib/calib_file.hpp"
 #include "skelgraph/eval/offline.hpp"
+#include "skelgraph/eval/recording.hpp"
 #include "skelgraph/mcap/mcap.hpp"
 #include "skelgraph/msg/cdr.hpp"
 #include "skelgraph/recording/bag.hpp"
@@ -41,26 +42,6 @@ namespace skelgraph::cli {
 
 namespace {
 
-nlohmann::json num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
-
-nlohmann::json stream_json(const eval::StreamScore& s) {
-  nlohmann::json groups = nlohmann::json::object();
-  const auto f = s.accuracy.figures();
-  for (std::size_t g = 0; g < eval::kGroupCount; ++g) {
-    groups[eval::group_names()[g]] = {{"detection_pct", f[g].detection_pct}, {"error_cm", num(f[g].error_cm)}};
-  }
-  return {{"stream", s.name},
-          {"fused", s.fused},
-          {"groups", groups},
-          {"mean_error_cm", num(s.accuracy.mean_error_cm())},
-          {"mean_group_error_cm", num(s.accuracy.mean_group_error_cm())},
-          {"after_calibration_mean_error_cm", num(s.after_calibration.mean_error_cm())},
-          {"compensated_mean_error_cm", num(s.compensated.mean_error_cm())},
-          {"upper_body_complete_pct", s.steadiness.upper_body_complete_pct()},
-          {"bone_length_sd_cm", num(s.steadiness.mean_bone_sd_cm())},
-          {"ticks", s.ticks},
-          {"ticks_with_output", s.with_output}};
-}
 
 void print_table(const std::string& title, const eval::OfflineResult& r) {
   std::printf("\n### %s\n\n| stream |", title.c_str());
@@ -250,183 +231,33 @@ std::string write_report_page(const std::string& dir, const std::string& heading
   return path.string();
 }
 
-// What a recording holds for evaluation, from a first pass over it: sensor
-// poses (the latest per sensor in the file), sync ticks, counts, and the ids
-// of the streams. The skeletons themselves are streamed by stream_recording.
-struct RecordingInputs {
-  std::string file;
-  std::map<std::string, Eigen::Isometry3d> poses;
-  std::vector<std::int64_t> ticks;  // log times of the sync TICKs, if the session was synchronised
-  std::uint64_t raw = 0, truth = 0, fused = 0;  // fused: recorded live fusion output
-  std::vector<std::string> sensor_ids, recorded_ids;  // in order of first appearance
-  std::int64_t lateness_ns = 0;  // the most a skeleton's log time falls behind an earlier one's in the file
-};
 
-// Which evaluated stream a channel carries (raw, truth, recorded live fusion), if any.
-std::optional<eval::TimedSkeleton::Kind> skeleton_kind(const mcap::Channel& ch, const mcap::Schema* schema) {
-  if (schema == nullptr || schema->name != msg::MessageTraits<msg::Skeleton>::name) return std::nullopt;
-  if (ch.topic == runtime::topics::kSkeletonRaw.name) return eval::TimedSkeleton::Kind::Raw;
-  if (ch.topic == runtime::topics::kSkeletonTruth.name) return eval::TimedSkeleton::Kind::Truth;
-  if (ch.topic == runtime::topics::kSkeletonFused.name) return eval::TimedSkeleton::Kind::Fused;
-  return std::nullopt;
-}
-
-skeleton::Skeleton skeleton_of(const mcap::Message& m) {
-  return skeleton::from_msg(msg::from_cdr<msg::Skeleton>(reinterpret_cast<const std::uint8_t*>(m.data.data()), m.data.size()));
-}
-
-// shared_frame: every sensor's skeletons are already in one frame (data sets
-// such as KinectMultiTrack map them so): identity poses, no calibration needed.
-// calibration: a calibration file whose poses replace the recording's.
-RecordingInputs read_recording(const std::string& file, bool shared_frame, const std::string& calibration = "") {
-  RecordingInputs in;
-  in.file = file;
-  try {
-    const mcap::Reader reader(file);
-    std::int64_t latest = std::numeric_limits<std::int64_t>::min();
-    reader.for_each_message([&](const mcap::Channel& ch, const mcap::Schema* schema, const mcap::Message& m) {
-      if (schema == nullptr) return;
-      const auto* bytes = reinterpret_cast<const std::uint8_t*>(m.data.data());
-      if (schema->name == msg::MessageTraits<msg::SensorPose>::name && ch.topic == runtime::topics::kCalibration.name) {
-        const auto p = skeleton::from_msg(msg::from_cdr<msg::SensorPose>(bytes, m.data.size()));
-        if (p.frame_id == "world") in.poses[p.sensor_id] = p.pose;
-      } else if (ch.topic == runtime::topics::kSync.name && schema->name == msg::MessageTraits<msg::SyncCommand>::name) {
-        if (msg::from_cdr<msg::SyncCommand>(bytes, m.data.size()).kind() == msg::SYNC_TICK) {
-          in.ticks.push_back(static_cast<std::int64_t>(m.log_time));
-        }
-      }
-      const auto kind = skeleton_kind(ch, schema);
-      if (!kind) return;
-      const auto t = static_cast<std::int64_t>(m.log_time);
-      if (latest != std::numeric_limits<std::int64_t>::min()) in.lateness_ns = std::max(in.lateness_ns, latest - t);
-      latest = std::max(latest, t);
-      if (*kind == eval::TimedSkeleton::Kind::Truth) {
-        ++in.truth;
-        return;
-      }
-      const auto id = skeleton_of(m).sensor_id;
-      auto& ids = *kind == eval::TimedSkeleton::Kind::Raw ? in.sensor_ids : in.recorded_ids;
-      if (std::find(ids.begin(), ids.end(), id) == ids.end()) ids.push_back(id);
-      ++(*kind == eval::TimedSkeleton::Kind::Raw ? in.raw : in.fused);
-    });
-  } catch (const mcap::McapError& e) {
-    throw UsageError(e.what());
-  }
-  std::sort(in.ticks.begin(), in.ticks.end());
-  if (in.raw == 0) throw UsageError(file + ": no raw skeletons on " + runtime::topics::kSkeletonRaw.name);
-  if (!calibration.empty()) {
-    try {
-      for (const auto& p : calib::read_calib_file(calibration).sensors) in.poses[p.sensor_id] = p.pose;
-    } catch (const calib::CalibFileError& e) {
-      throw UsageError(e.what());
-    }
-  }
-  for (const auto& id : in.sensor_ids) {
-    if (shared_frame) in.poses.try_emplace(id, Eigen::Isometry3d::Identity());
-    if (!in.poses.count(id)) {
-      throw UsageError(file + ": no pose of sensor '" + id + "' on " + runtime::topics::kCalibration.name +
-                       " (calibrate it, record the calibration topic, or --shared-frame if the data is already in one frame)");
-    }
-  }
-  return in;
-}
-
-// The recording's skeletons into `ev` in time order (ties in file order): a
-// second pass, held back only as far as the file's own disorder (lateness_ns)
-// requires, so a long recording is never held whole. `each`, if given, sees
-// every message of the file in file order, after its skeleton went in.
-using MessageHook = std::function<void(const mcap::Channel&, const mcap::Message&)>;
-void stream_recording(const RecordingInputs& in, eval::Evaluator& ev, const MessageHook& each = {}) {
-  struct Held {
-    eval::TimedSkeleton e;
-    std::uint64_t seq;
-  };
-  const auto later = [](const Held& a, const Held& b) { return a.e.t_ns != b.e.t_ns ? a.e.t_ns > b.e.t_ns : a.seq > b.seq; };
-  std::priority_queue<Held, std::vector<Held>, decltype(later)> held(later);
-  std::uint64_t seq = 0;
-  std::int64_t latest = std::numeric_limits<std::int64_t>::min();
-  // Progress for recordings that take a while (over ~10 minutes of two sensors).
-  const std::uint64_t total = in.raw + in.truth + in.fused;
-  Progress progress(total > 40'000);
-  try {
-    const mcap::Reader reader(in.file);
-    reader.for_each_message([&](const mcap::Channel& ch, const mcap::Schema* schema, const mcap::Message& m) {
-      if (const auto kind = skeleton_kind(ch, schema)) {
-        if (seq % 5000 == 0)
-          progress(in.file + ": " + std::to_string(seq) + " of " + std::to_string(total) + " skeletons fused and scored (" +
-                   std::to_string(100 * seq / total) + " %)");
-        const auto t = static_cast<std::int64_t>(m.log_time);
-        latest = std::max(latest, t);
-        held.push({{*kind, t, skeleton_of(m)}, seq++});
-        while (!held.empty() && held.top().e.t_ns <= latest - in.lateness_ns) {
-          ev.add(held.top().e);
-          held.pop();
-        }
-      }
-      if (each) each(ch, m);
-    });
-  } catch (const mcap::McapError& e) {
-    throw UsageError(e.what());
-  }
-  for (; !held.empty(); held.pop()) ev.add(held.top().e);
-  progress.done(false);
-}
-
-struct FileOptions {
+struct FileOptions : eval::RecordingOptions {
   std::string file, out, report_dir, csv;
-  std::vector<std::string> methods;
-  double delay_ms = 0, max_age_ms = 100;
-  bool json = false, shared_frame = false;
-  std::string calibration;  // a calibration file's poses instead of the recording's
+  bool json = false;
 };
 
-eval::OfflineOptions offline_options(const std::vector<std::string>& methods, double delay_ms, double max_age_ms) {
-  eval::OfflineOptions eo;
-  if (!methods.empty()) {
-    eo.methods.clear();
-    for (const auto& m : methods) eo.methods.push_back(*fusion::method_from_name(m));
+// The library's errors are the user's input: exit 2 with the message.
+template <class F>
+auto user_input(F&& f) {
+  try {
+    return f();
+  } catch (const eval::RecordingError& e) {
+    throw UsageError(e.what());
   }
-  eo.fuser.delay_ns = static_cast<std::int64_t>(delay_ms * 1e6);
-  eo.fuser.max_age_ns = static_cast<std::int64_t>(max_age_ms * 1e6);
-  return eo;
-}
-// A recording's fusion runs on its sync TICKs when it has them (as the live component does), else at 30 Hz.
-eval::OfflineOptions offline_options(const FileOptions& o, const RecordingInputs& in) {
-  auto eo = offline_options(o.methods, o.delay_ms, o.max_age_ms);
-  eo.tick_times = in.ticks;
-  return eo;
 }
 
-// skelgraph eval FILE: single sensors and every method, against the truth in the
-// recording if it has one; bone-length steadiness and completeness either way.
-// A recording scored (with traces for plots when asked) and its summary as JSON.
-struct ScoredRecording {
-  RecordingInputs in;
-  eval::OfflineResult result;
-  nlohmann::json summary;
-};
-ScoredRecording score_recording(const FileOptions& o, bool trace) {
-  ScoredRecording s{read_recording(o.file, o.shared_frame, o.calibration), {}, {}};
-  auto eo = offline_options(o, s.in);
-  eo.trace = trace;
-  eval::Evaluator ev(s.in.poses, s.in.sensor_ids, s.in.recorded_ids, eo);
-  stream_recording(s.in, ev);
-  s.result = ev.finish();
-  nlohmann::json streams = nlohmann::json::array();
-  for (const auto& st : s.result.streams) streams.push_back(stream_json(st));
-  s.summary = {{"file", o.file},
-               {"has_truth", s.result.has_truth},
-               {"ticks", s.result.ticks},
-               {"on_sync_ticks", !s.in.ticks.empty()},
-               {"raw_skeletons", s.in.raw},
-               {"truth_skeletons", s.in.truth},
-               {"live_fused_skeletons", s.in.fused},
-               {"streams", streams}};
-  return s;
+// A long recording's progress on stderr.
+eval::ProgressFn progress_of(Progress& p) {
+  return [&p](const std::string& text) { p(text); };
 }
 
+// skelgraph eval FILE: single sensors and every method, against the truth in the recording if it
+// has one; bone-length steadiness and completeness either way.
 int eval_file(const FileOptions& o) {
-  const auto scored = score_recording(o, !o.report_dir.empty());
+  Progress progress;
+  const auto scored = user_input([&] { return eval::score_recording(o.file, o, !o.report_dir.empty(), progress_of(progress)); });
+  progress.done(false);
   const auto& in = scored.in;
   const auto& r = scored.result;
   std::string report_path;
@@ -504,77 +335,15 @@ int eval_live(const LiveOptions& o, GlobalOptions& g) {
 // skelgraph fuse IN --out OUT: the recording with fused skeletons added on
 // skelgraph/skeleton/fused (sensor_id "fused", or "fused_<method>" for several).
 int fuse_file(const FileOptions& o) {
-  const auto in = read_recording(o.file, o.shared_frame, o.calibration);
-  auto eo = offline_options(o, in);
-  eo.singles = false;  // only the methods go into the file
-  // One pass: every message is copied in file order, each after the fused
-  // skeletons up to its log time; a message waits only until the fusion has
-  // got that far (a few seconds), so neither side is held whole.
-  std::deque<std::pair<std::int64_t, skeleton::Skeleton>> fused;  // in time order, as the ticks make them
-  std::uint64_t fused_count = 0, copied = 0;
-  eval::Evaluator ev(in.poses, in.sensor_ids, {}, eo, [&](fusion::Method m, const skeleton::Skeleton& s) {
-    auto f = s;
-    f.sensor_id = eo.methods.size() == 1 ? "fused" : std::string("fused_") + fusion::method_name(m);
-    fused.emplace_back(s.stamp_ns + eo.fuser.delay_ns, std::move(f));
-    ++fused_count;
-  });
-  struct Copy {
-    std::string topic, type;
-    bool keyed;
-    std::string data;
-    std::uint64_t log_time, publish_time;
-  };
-  std::deque<Copy> copies;
-  eval::OfflineResult r;
-  try {
-    recording::BagWriter bag(o.out);
-    const auto fused_until = [&](std::uint64_t t) {
-      for (; !fused.empty() && static_cast<std::uint64_t>(std::max<std::int64_t>(0, fused.front().first)) <= t; fused.pop_front()) {
-        const auto at = static_cast<std::uint64_t>(std::max<std::int64_t>(0, fused.front().first));
-        bag.write(runtime::topics::kSkeletonFused.name, skeleton::to_msg(fused.front().second), at, at);
-      }
-    };
-    const auto copy_until = [&](std::int64_t done) {
-      for (; !copies.empty() && (done == std::numeric_limits<std::int64_t>::max() ||
-                                 (done >= 0 && copies.front().log_time <= static_cast<std::uint64_t>(done)));
-           copies.pop_front()) {
-        const auto& c = copies.front();
-        fused_until(c.log_time);
-        bag.write_cdr(c.topic, c.type, c.keyed, c.data, c.log_time, c.publish_time);
-        ++copied;
-      }
-    };
-    stream_recording(in, ev, [&](const mcap::Channel& ch, const mcap::Message& m) {
-      if (ch.topic == runtime::topics::kSkeletonFused.name) return;  // replaced
-      const auto type = ch.metadata.count("dds_type") ? ch.metadata.at("dds_type") : std::string();
-      const bool keyed = ch.metadata.count("keyed") && ch.metadata.at("keyed") == "true";
-      copies.push_back({ch.topic, type, keyed, std::string(m.data.begin(), m.data.end()), m.log_time, m.publish_time});
-      copy_until(ev.done_until());
-    });
-    r = ev.finish();
-    copy_until(std::numeric_limits<std::int64_t>::max());
-    fused_until(UINT64_MAX);
-    bag.close();
-  } catch (const mcap::McapError& e) {
-    throw UsageError(e.what());
-  }
-  nlohmann::json per = nlohmann::json::object();
-  for (std::size_t i = 0; i < r.streams.size(); ++i) {
-    per[r.streams[i].name] = {{"ticks_with_output", r.streams[i].with_output},
-                              {"flips_corrected", r.fuser_stats[i].flips_corrected},
-                              {"gated", r.fuser_stats[i].gated},
-                              {"occluded_views", r.fuser_stats[i].occluded_views}};
-  }
+  Progress progress;
+  const auto j = user_input([&] { return eval::fuse_recording(o.file, o.out, o, progress_of(progress)); });
+  progress.done(false);
   if (o.json) {
-    std::printf("%s\n", nlohmann::json{{"in", o.file}, {"out", o.out}, {"copied", copied}, {"fused", fused_count},
-                                       {"on_sync_ticks", !in.ticks.empty()},
-                                       {"ticks", r.ticks}, {"methods", per}}
-                            .dump(2)
-                            .c_str());
+    std::printf("%s\n", j.dump(2).c_str());
   } else {
     std::printf("%s: %llu fused skeletons (%s) added to %llu messages of %s\n", o.out.c_str(),
-                static_cast<unsigned long long>(fused_count),
-                per.dump().c_str(), static_cast<unsigned long long>(copied), o.file.c_str());
+                static_cast<unsigned long long>(j["fused"].get<std::uint64_t>()), j["methods"].dump().c_str(),
+                static_cast<unsigned long long>(j["copied"].get<std::uint64_t>()), o.file.c_str());
   }
   return 0;
 }
@@ -584,7 +353,7 @@ int fuse_file(const FileOptions& o) {
 RecordingReport eval_recording_section(const std::string& file, const std::string& report_dir, const std::string& title) {
   FileOptions o;
   o.file = file;
-  const auto scored = score_recording(o, true);
+  const auto scored = user_input([&] { return eval::score_recording(o.file, o, true); });
   std::filesystem::create_directories(report_dir);
   return {scored.summary, report_section(report_dir, "live", title, scored.result, "right_hand")};
 }
@@ -592,7 +361,7 @@ RecordingReport eval_recording_section(const std::string& file, const std::strin
 int eval_sim(const SimEvalOptions& o) {
   runtime::ParamSchema schema;
   sim::add_sim_params(schema);
-  eval::OfflineOptions eo = offline_options(o.methods, o.delay_ms, o.max_age_ms);
+  eval::OfflineOptions eo = eval::offline_options(o.methods, o.delay_ms, o.max_age_ms);
   eo.trace = !o.report_dir.empty();
   std::string html;
   if (eo.trace) std::filesystem::create_directories(o.report_dir);
@@ -671,7 +440,7 @@ int eval_sim(const SimEvalOptions& o) {
     if (o.quiet) std::fprintf(stderr, "evaluated %s: %zu streams over %llu ticks\n", scenario.c_str(), r.streams.size(),
                               static_cast<unsigned long long>(r.ticks));
     nlohmann::json streams = nlohmann::json::array();
-    for (const auto& s : r.streams) streams.push_back(stream_json(s));
+    for (const auto& s : r.streams) streams.push_back(eval::stream_json(s));
     out.push_back({{"scenario", scenario}, {"sensors", cfg.sensors.size()}, {"profile", cfg.profile},
                    {"seed", cfg.scenario.seed}, {"ticks", r.ticks}, {"streams", streams}, {"source", o.source}});
     if (!depth_info.is_null()) out.back()["depth"] = depth_info;

@@ -15,6 +15,7 @@
 
 #include "cli.hpp"
 #include "skelgraph/gesture/classifier.hpp"
+#include "skelgraph/gesture/clip_spotting.hpp"
 #include "skelgraph/gesture/dataset.hpp"
 #include "skelgraph/gesture/sim_sessions.hpp"
 #include "skelgraph/gesture/spotter.hpp"
@@ -303,175 +304,43 @@ int gesture_cv(const GestureOptions& o) {
   return 0;
 }
 
-// The same person with both arms hanging: elbows, wrists and hands straight
-// below their shoulders, segment lengths kept.
-std::pair<skeleton::Skeleton, Wrists> arms_down(const skeleton::Skeleton& s, const Wrists& w) {
-  using skeleton::JointId;
-  auto r = s;
-  Wrists rw = w;
-  const Eigen::Vector3d down(0, -1, 0);
-  const JointId arms[2][3] = {{JointId::LeftShoulder, JointId::LeftElbow, JointId::LeftHand},
-                              {JointId::RightShoulder, JointId::RightElbow, JointId::RightHand}};
-  for (int side = 0; side < 2; ++side) {
-    const auto [sh, el, ha] = std::tuple{s[arms[side][0]].position, s[arms[side][1]].position, s[arms[side][2]].position};
-    const Eigen::Vector3d elbow = sh + (el - sh).norm() * down;
-    r[arms[side][1]].position = elbow;
-    r[arms[side][2]].position = elbow + (ha - el).norm() * down;
-    Eigen::Vector3d& wr = side == 0 ? rw.left : rw.right;
-    if (wr.allFinite()) wr = elbow + (wr - el).norm() * down;
-  }
-  return {r, rw};
-}
-
-// Continuous streams of real clips: each subject's recordings (in file-name
-// order: the order they were performed) played one after another with
-// `gap` s of the last frame held between them, spotted by a model trained on
-// the other subjects; truth: each clip's motion span, labelled by its class.
+// Leave-subject-out spotting in continuous streams of real clips (gesture/clip_spotting.hpp).
 int gesture_spot(const GestureOptions& o) {
   const auto map = class_map(o.classes);
   const auto c = classifier_options(o);
-  const auto format = *playback::format_from_name(o.format);
-  DatasetOptions d;
-  d.format = format;
-  d.features = c.features;
-  d.trim = c.trimmed;
   const auto clips = load(o, map, c);
-  std::map<std::string, std::vector<std::size_t>> by_subject;
-  for (std::size_t i = 0; i < clips.size(); ++i) by_subject[clips[i].subject].push_back(i);
-  if (by_subject.size() < 2) throw UsageError("gesture spot needs recordings of at least 2 subjects (each is spotted by a model trained on the others)");
-  const std::string label = map.classes[0];
-  std::vector<SpottingReport> reports;
-  nlohmann::json per = nlohmann::json::array();
-  int done = 0;
+  ClipStreamOptions so;
+  so.format = *playback::format_from_name(o.format);
+  so.gap_s = o.gap;
+  so.rest_s = o.rest;
+  so.spot = o.spot;
   Progress progress;
-  for (const auto& [subject, idx] : by_subject) {
-    std::vector<Clip> train;
-    for (std::size_t i = 0; i < clips.size(); ++i)
-      if (clips[i].subject != subject) train.push_back(clips[i]);
-    const auto model = Classifier::train(train, map, c);
-    // The stream.
-    std::vector<skeleton::Skeleton> stream;
-    std::vector<Wrists> wrists;  // per stream frame, for the hands features
-    std::vector<TruthGesture> truth;
-    struct ClipRange {
-      std::int64_t start_ns, end_ns;
-      std::string action;
-    };
-    std::vector<ClipRange> ranges;  // each clip's place in the stream, to say which clip an event came in
-    std::int64_t t0 = 0;
-    const auto gap = static_cast<std::int64_t>(o.gap * 1e9);
-    constexpr std::int64_t kFrame = 33'333'333;
-    // --rest: from (a, wa) to (b, wb) over `seconds`, 30 Hz, positions blended linearly.
-    const auto move = [&](const skeleton::Skeleton& a, const Wrists& wa, const skeleton::Skeleton& b, const Wrists& wb,
-                          double seconds) {
-      const auto n = static_cast<int>(std::lround(seconds * 30));
-      for (int k = 1; k <= n; ++k) {
-        const double u = static_cast<double>(k) / n;
-        auto f = a;
-        for (std::size_t j = 0; j < f.joints.size(); ++j)
-          f.joints[j].position = (1 - u) * a.joints[j].position + u * b.joints[j].position;
-        f.stamp_ns = stream.empty() ? t0 : stream.back().stamp_ns + kFrame;
-        stream.push_back(f);
-        wrists.push_back({(1 - u) * wa.left + u * wb.left, (1 - u) * wa.right + u * wb.right});
-      }
-    };
-    constexpr double kLower = 0.5;  // s to lower or raise the arms
-    for (std::size_t i : idx) {
-      const auto rec = playback::read_recording(format, clips[i].source);
-      const auto rec_wrists = wrists_of(rec);
-      const auto wrist_at = [&](std::size_t k) { return rec_wrists.empty() ? Wrists{} : rec_wrists[k]; };
-      if (o.rest > 0) {
-        // Arms down from the last frame, rest, arms up into this clip's first frame.
-        auto first = rec.frames.front();
-        first.person_id = 1;
-        const auto [rest_next, rest_next_w] = arms_down(first, wrist_at(0));
-        if (stream.empty()) {
-          stream.push_back(rest_next);
-          stream.back().stamp_ns = t0;
-          wrists.push_back(rest_next_w);
-          move(rest_next, rest_next_w, rest_next, rest_next_w, o.rest);
-        } else {
-          const auto [rest_prev, rest_prev_w] = arms_down(stream.back(), wrists.back());
-          const auto last_frame = stream.back();
-          const auto last_w = wrists.back();
-          move(last_frame, last_w, rest_prev, rest_prev_w, kLower);
-          move(rest_prev, rest_prev_w, rest_next, rest_next_w, o.rest);
-        }
-        move(rest_next, rest_next_w, first, wrist_at(0), kLower);
-        t0 = stream.back().stamp_ns + kFrame;
-      }
-      const std::int64_t shift = t0 - rec.frames.front().stamp_ns;
-      std::int64_t last = t0;
-      ranges.push_back({t0, rec.frames.back().stamp_ns + shift, clips[i].action});
-      for (std::size_t k = 0; k < rec.frames.size(); ++k) {
-        auto f = rec.frames[k];
-        f.stamp_ns += shift;
-        f.person_id = 1;
-        if (!stream.empty() && f.stamp_ns <= stream.back().stamp_ns) continue;
-        last = f.stamp_ns;
-        stream.push_back(f);
-        wrists.push_back(wrist_at(k));
-      }
-      const auto span = motion_span(recording_features(rec, c.features).x, c.features.set);
-      TruthGesture g;
-      g.label = clips[i].label >= 0 ? map.classes[static_cast<std::size_t>(clips[i].label)] : clips[i].action;
-      g.start_ns = rec.frames[static_cast<std::size_t>(span.begin)].stamp_ns + shift;
-      g.end_ns = rec.frames[static_cast<std::size_t>(std::max<Eigen::Index>(span.begin, span.end - 1))].stamp_ns + shift;
-      truth.push_back(g);
-      for (std::int64_t t = last + 33'333'333; t < last + gap; t += 33'333'333) {
-        auto f = stream.back();
-        f.stamp_ns = t;
-        stream.push_back(f);
-        wrists.push_back(wrists.back());
-      }
-      t0 = stream.back().stamp_ns + kFrame;  // the next clip one frame after the rest
-    }
-    if (o.rest > 0 && !stream.empty()) {  // the last clip ends in a rest too
-      const auto [rest_last, rest_last_w] = arms_down(stream.back(), wrists.back());
-      const auto last_frame = stream.back();
-      const auto last_w = wrists.back();
-      move(last_frame, last_w, rest_last, rest_last_w, kLower);
-      move(rest_last, rest_last_w, rest_last, rest_last_w, o.rest);
-    }
-    Spotter spotter(model, o.spot);
-    std::vector<SpottedEvent> events;
-    for (std::size_t k = 0; k < stream.size(); ++k)
-      for (const auto& e : spotter.step(stream[k], needs_wrists(c.features.set) ? &wrists[k] : nullptr)) events.push_back(e);
-    const auto r = score_spotting(events, truth, label);
-    reports.push_back(r);
-    nlohmann::json ev = nlohmann::json::array();
-    const std::int64_t origin = stream.empty() ? 0 : stream.front().stamp_ns;
-    for (const auto& e : events) {
-      std::string in = "rest";
-      for (const auto& cr : ranges)
-        if (e.end_ns >= cr.start_ns && e.end_ns <= cr.end_ns) in = cr.action;
-      ev.push_back({{"label", e.label}, {"clip", in}, {"start_s", 1e-9 * static_cast<double>(e.start_ns - origin)},
-                    {"end_s", 1e-9 * static_cast<double>(e.end_ns - origin)}, {"confidence", e.confidence}});
-    }
-    nlohmann::json tj = nlohmann::json::array();
-    for (std::size_t k = 0; k < truth.size(); ++k)
-      tj.push_back({{"clip", ranges[k].action}, {"label", truth[k].label}, {"clip_start_s", 1e-9 * static_cast<double>(ranges[k].start_ns - origin)},
-                    {"clip_end_s", 1e-9 * static_cast<double>(ranges[k].end_ns - origin)},
-                    {"motion_start_s", 1e-9 * static_cast<double>(truth[k].start_ns - origin)},
-                    {"motion_end_s", 1e-9 * static_cast<double>(truth[k].end_ns - origin)}});
-    per.push_back({{"subject", subject}, {"clips", idx.size()}, {"truth", r.truth}, {"events", r.events},
-                   {"true_positive", r.true_positive}, {"f1", r.f1}, {"spotted", ev}, {"clips_in_stream", tj}});
-    ++done;
-    progress("spotted subject " + std::to_string(done) + "/" + std::to_string(by_subject.size()),
-             static_cast<std::size_t>(done) == by_subject.size());
+  ClipSpotting r;
+  try {
+    r = spot_clips(clips, map, c, so, [&](int done, int total) {
+      progress("spotted subject " + std::to_string(done) + "/" + std::to_string(total), done == total);
+    });
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("gesture spot: ") + e.what());
   }
-  const auto r = combine(reports);
   if (o.json) {
-    std::printf("%s\n", nlohmann::json{{"label", label}, {"config", config_json(c)}, {"gap_s", o.gap}, {"rest_s", o.rest}, {"spotting", to_json(r)},
-                                        {"subjects", per}}
+    nlohmann::json per = nlohmann::json::array();
+    for (const auto& s : r.subjects) {
+      per.push_back({{"subject", s.subject}, {"clips", s.clips}, {"truth", s.report.truth}, {"events", s.report.events},
+                     {"true_positive", s.report.true_positive}, {"f1", s.report.f1}, {"spotted", s.spotted},
+                     {"clips_in_stream", s.clips_in_stream}});
+    }
+    std::printf("%s\n", nlohmann::json{{"label", r.label}, {"config", config_json(c)}, {"gap_s", o.gap}, {"rest_s", o.rest},
+                                        {"spotting", to_json(r.combined)}, {"subjects", per}}
                             .dump(2)
                             .c_str());
     return 0;
   }
+  const auto& t = r.combined;
   std::printf("leave-subject-out spotting in continuous streams of %zu clips (%.1f s of the last frame held, %.1f s of arms-down rest "
               "between them):\n", clips.size(), o.gap, o.rest);
   std::printf("%s: %d true, %d events: precision %.3f recall %.3f F1 %.3f; latency from the end of the motion: median %.0f ms\n",
-              label.c_str(), r.truth, r.events, r.precision, r.recall, r.f1, 1e3 * r.median_latency_s);
+              r.label.c_str(), t.truth, t.events, t.precision, t.recall, t.f1, 1e3 * t.median_latency_s);
   return 0;
 }
 

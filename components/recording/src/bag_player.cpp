@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <climits>
-#include <queue>
 #include <sstream>
 
+#include "skelgraph/runtime/ordered_queue.hpp"
 #include "skelgraph/runtime/topics.hpp"
 
 namespace skelgraph::recording {
@@ -205,21 +205,18 @@ void BagPlayer::wait_until_due(std::uint64_t log_time) {
 
 void BagPlayer::play_once(std::uint64_t from) {
   struct Pending {
-    std::uint64_t log_time, order;
     std::size_t publisher;
     msg::RawSample sample;
   };
-  const auto later = [](const Pending& a, const Pending& b) {
-    return a.log_time != b.log_time ? a.log_time > b.log_time : a.order > b.order;
-  };
-  std::priority_queue<Pending, std::vector<Pending>, decltype(later)> pending(later);
-  std::uint64_t order = 0, newest = 0, last_played = 0;
-  const auto play = [&] {
-    auto p = pending.top();  // copy: pop() below invalidates it
-    pending.pop();
-    if (p.log_time < last_played) ++reordered_late_;  // further out of order than reorder_s
-    last_played = std::max(last_played, p.log_time);
-    const auto t = std::max(p.log_time, first_log_time_);
+  // Messages up to reorder_s out of log-time order in the file are played in order.
+  runtime::OrderedQueue<Pending> pending;
+  pending.add_stream(0, static_cast<std::int64_t>(reorder_ns_));
+  std::uint64_t last_played = 0;
+  const auto play = [&](std::int64_t log_time, Pending&& p) {
+    const auto lt = static_cast<std::uint64_t>(log_time);
+    if (lt < last_played) ++reordered_late_;  // further out of order than reorder_s
+    last_played = std::max(last_played, lt);
+    const auto t = std::max(lt, first_log_time_);
     if (t < from) {  // before a seek's position: only the latest state matters
       if (publisher_is_state_[p.publisher]) publishers_[p.publisher]->publish(p.sample);
       return;
@@ -242,13 +239,12 @@ void BagPlayer::play_once(std::uint64_t from) {
   reader_.for_each_message([&](const mcap::Channel& ch, const mcap::Schema*, const mcap::Message& m) {
     const auto it = publisher_of_channel_.find(ch.id);
     if (it == publisher_of_channel_.end()) return;
-    Pending p{m.log_time, order++, it->second, {}};
+    Pending p{it->second, {}};
     p.sample.payload.assign(m.data.begin(), m.data.end());
-    pending.push(std::move(p));
-    newest = std::max(newest, m.log_time);
-    while (!pending.empty() && pending.top().log_time + reorder_ns_ <= newest) play();
+    pending.push(0, static_cast<std::int64_t>(m.log_time), std::move(p));
+    pending.drain(play);
   });
-  while (!pending.empty()) play();
+  pending.flush(play);
 }
 
 // Keyed streams of live topics not seen since `before_log_ns` are disposed
