@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <deque>
+#include <functional>
 #include <limits>
 #include <utility>
 
@@ -38,6 +39,14 @@ constexpr std::size_t kHistory = 4;          // samples kept per stream (enough 
 constexpr double kGate = 16.27;              // chi-square, 3 dof, 99.9 %
 constexpr int kResetAfterMisses = 5;         // all measurements gated this often in a row: start over
 constexpr std::int64_t kCoastNs = 200'000'000;  // a filtered joint without measurements stays "inferred" this long
+constexpr std::int64_t kSettledNs = 1'000'000'000;  // a tracker's fresh skeleton is tens of centimetres off this long
+// Evidence for a heading (facing_evidence), log-odds per frame: the fused neck over kLeanAt in front of the
+// hips; a pair of views (in front, behind) whose recent arm confidences differ by over the margin. Kept with
+// this memory per frame (30 Hz: about 3 s), at most kBeliefMax; the heading turned round below -kReverseAt.
+constexpr double kLeanAt = 0.15, kLeanWeight = 0.3;
+constexpr double kConfWeight = 0.5, kConfMargin = 0.02;
+constexpr double kBeliefMemory = 0.99, kBeliefMax = 10.0, kReverseAt = 3.0;
+constexpr double kArmMemory = 0.97;  // the arm confidence of a stream, averaged over about a second
 
 struct Sample {
   std::int64_t t;
@@ -47,6 +56,7 @@ struct Sample {
 struct Stream {
   std::size_t sensor;
   std::int64_t first_ns = 0;  // its first sample: a tracker's fresh skeleton is still settling
+  double arm_confidence = 1.0;  // mean confidence of its arm joints, lately (kArmMemory)
   std::deque<Sample> samples;
   std::optional<std::uint32_t> track;
 };
@@ -81,6 +91,7 @@ struct Track {
   std::int64_t last_ns = 0;
   Vector3d centre = Vector3d::Zero();
   std::optional<Vector3d> heading;  // horizontal unit vector the torso faces
+  double heading_belief = 0;        // evidence for the heading over its reverse (log-odds; negative: against it)
   std::array<JointFilter, kJointCount> filters;
   std::array<int, kJointCount> misses{};
   std::array<std::int64_t, kJointCount> last_update_ns{};
@@ -218,9 +229,55 @@ struct Fuser::Impl {
     return by_track;
   }
 
+  // Evidence that the person faces `h` rather than the reverse (a log-odds),
+  // from one moment's views. Which way a view labels left and right says
+  // little: every tracker assumes the person faces it and mirrors them when
+  // it sees their back, so with sensors on opposite sides both headings
+  // explain the labels (without such a pair, as with the thesis's two
+  // sensors 90 degrees apart, the labels do tell: no evidence is needed and
+  // none is given). Two things do tell:
+  //  - a person bent over (picking something up, sitting down) leans
+  //    forwards: the fused neck well in front of the hips (labels do not
+  //    matter); while so, nothing else counts (hands on an object are
+  //    reported less surely from the front, which would mislead the next);
+  //  - a tracker is surer of the arms it sees from the front: of two views,
+  //    one in front of the person and one behind by `h`, the one in front
+  //    should have reported the arms at confidence 1 more often lately.
+  // Fresh skeletons (under a second old) are tens of centimetres off: not counted.
+  double facing_evidence(const Vector3d& h, const std::vector<View*>& vs, std::int64_t t, const Track& tr) const {
+    const auto settled = [&](const View* v) { return t - v->stream->first_ns >= kSettledNs && !v->occluded; };
+    const auto way = [&](const View* v) {
+      Vector3d u = sensor_position(v->sensor) - v->centre;
+      u.y() = 0;
+      return u.norm() > 1e-6 ? Vector3d(u.normalized()) : Vector3d::Zero();
+    };
+    bool opposite = false;
+    for (const View* a : vs) {
+      for (const View* b : vs) opposite = opposite || (settled(a) && settled(b) && way(a).dot(way(b)) < -0.5);
+    }
+    if (!opposite) return 0;
+    if (tr.frames > 0) {
+      Vector3d lean = tr.last[JointId::Neck].position -
+                      0.5 * (tr.last[JointId::LeftHip].position + tr.last[JointId::RightHip].position);
+      lean.y() = 0;
+      if (lean.norm() > kLeanAt) return lean.dot(h) > 0 ? kLeanWeight : -kLeanWeight;
+    }
+    double e = 0;
+    for (const View* a : vs) {
+      if (!settled(a) || h.dot(way(a)) < 0.3) continue;  // a: in front of the person, by h
+      for (const View* b : vs) {
+        if (!settled(b) || h.dot(way(b)) > -0.3) continue;  // b: behind
+        const double d = a->stream->arm_confidence - b->stream->arm_confidence;
+        if (std::abs(d) > kConfMargin) e += d > 0 ? kConfWeight : -kConfWeight;
+      }
+    }
+    return e;
+  }
+
   // Heading of the person and, against it, which views see the back (their
-  // left and right swapped). The heading starts once the views agree on it.
-  void update_heading(Track& tr, std::vector<View*>& vs, bool correct_flips) {
+  // left and right swapped). The heading starts once the views agree on it,
+  // or one heading explains them best (disputed_heading).
+  void update_heading(Track& tr, std::vector<View*>& vs, bool correct_flips, std::int64_t t) {
     std::vector<std::pair<View*, Vector3d>> claims;
     for (View* v : vs) {
       if (v->occluded) continue;  // a ghost on an occluder says nothing about where the person faces
@@ -235,8 +292,31 @@ struct Fuser::Impl {
         Vector3d sum = Vector3d::Zero();
         for (const auto& c : claims) sum += c.second;
         if (sum.norm() > 1e-6) tr.heading = sum.normalized();
+      } else if (!claims.empty()) {
+        // The views disagree (one behind the person mirrors them): the claim,
+        // or claim reversed, the evidence favours (the first claim when none).
+        double best = -std::numeric_limits<double>::infinity();
+        for (const auto& [v, c] : claims) {
+          for (const double sign : {1.0, -1.0}) {
+            const double e = facing_evidence(sign * c, vs, t, tr);
+            if (e > best + 1e-9) {
+              best = e;
+              tr.heading = sign * c;
+            }
+          }
+        }
       }
     } else {
+      // The evidence for the heading, with a memory of a few seconds; a
+      // heading it holds against (taken from mirrored views: a sensor behind
+      // the person saw them first) is turned round.
+      tr.heading_belief = std::clamp(kBeliefMemory * tr.heading_belief + facing_evidence(*tr.heading, vs, t, tr),
+                                     -kBeliefMax, kBeliefMax);
+      if (tr.heading_belief <= -kReverseAt) {
+        tr.heading = -*tr.heading;
+        tr.heading_belief = -tr.heading_belief;
+        ++stats.headings_reversed;
+      }
       Vector3d sum = Vector3d::Zero();
       for (auto& [v, f] : claims) {
         if (f.dot(*tr.heading) < -0.2) {  // this sensor sees the back and labels it as the front
@@ -316,7 +396,6 @@ struct Fuser::Impl {
   // someone places them tens of centimetres off for a while, either way).
   void mark_occluded(std::vector<View*>& vs, std::int64_t t) {
     constexpr double kApart = 0.3;  // m between the skeletons' centres: beyond any tracker noise
-    constexpr std::int64_t kSettledNs = 1'000'000'000;
     const auto settled = [&](const View& v) { return t - v.stream->first_ns >= kSettledNs; };
     const auto behind = [&](const View& v, const View& u) {  // u hidden behind v from v's sensor
       const Vector3d ray = (v.centre - sensor_position(v.sensor)).normalized();
@@ -494,7 +573,7 @@ struct Fuser::Impl {
     for (auto& [id, vs] : by_track) {
       Track& tr = track_by_id(id);
       if (opt.method == Method::Kalman) mark_occluded(vs, t);
-      update_heading(tr, vs, opt.method == Method::Kalman);
+      update_heading(tr, vs, opt.method == Method::Kalman || opt.method == Method::Weighted, t);
       skeleton::Skeleton f;
       f.sensor_id = "fused";
       f.person_id = id;
@@ -563,6 +642,12 @@ void Fuser::add(const skeleton::Skeleton& raw, std::int64_t t_ns) {
   // Samples arrive in time order from one sensor; keep a few for interpolation.
   auto pos = std::upper_bound(st.samples.begin(), st.samples.end(), t_ns,
                               [](std::int64_t t, const Sample& x) { return t < x.t; });
+  double arms = 0;
+  for (const auto j : {JointId::LeftShoulder, JointId::LeftElbow, JointId::LeftHand, JointId::RightShoulder,
+                       JointId::RightElbow, JointId::RightHand}) {
+    arms += raw[j].confidence;
+  }
+  st.arm_confidence = kArmMemory * st.arm_confidence + (1 - kArmMemory) * arms / 6;
   st.samples.insert(pos, std::move(s));
   while (st.samples.size() > kHistory) st.samples.pop_front();
   ++impl_->stats.added;

@@ -11,11 +11,14 @@
 //  sum      the thesis's: among sensors with confidence 1 for the joint, the
 //           one whose skeleton has the highest confidence sum.
 //  facing   the sensor the torso faces (the thesis's first demo), else any.
-//  weighted mean weighted by confidence, view angle and distance.
+//  weighted mean weighted by confidence, view angle and distance; sensors
+//           seeing the person's back corrected as kalman's are.
 //  kalman   a constant-velocity filter per joint; measurement noise from
 //           confidence, view angle and distance; Mahalanobis gating; sensors
 //           seeing the person's back (left/right swapped) are detected against
-//           the person's heading and corrected; limb lengths held steady;
+//           the person's heading and corrected (with sensors on opposite
+//           sides, the heading is a belief fed by what tells front from back:
+//           a forward lean, the front view's surer arms); limb lengths held steady;
 //           when two sensors place the person apart, the one whose skeleton
 //           lies in front of the other's along its own line of sight (it sees
 //           an occluder, where a tracker that lost the person leaves its
@@ -54,6 +57,7 @@ struct FuserStats {
   std::uint64_t added = 0, no_pose = 0, fused = 0, flips_corrected = 0, gated = 0;
   std::uint64_t tracks_merged = 0;  // a sensor's stream moved to an older track of the same person
   std::uint64_t streams_ended = 0;  // remove(): a sensor's tracker said it lost a person
+  std::uint64_t headings_reversed = 0;  // a heading the views' evidence held against, turned round
   // kalman: views left out because they disagreed with another sensor's and
   // lay in front of it along their own line of sight (on an occluder: a ghost)
   std::uint64_t occluded_views = 0;
