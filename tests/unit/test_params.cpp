@@ -117,3 +117,12 @@ TEST(Params, AssignmentParsing) {
   EXPECT_THROW(parse_param_assignment("novalue", "--param"), ParamError);
   EXPECT_THROW(parse_param_assignment("=3", "--param"), ParamError);
 }
+
+// "-p sensors=a:0,1.2,2,180,b:2,1.2,0,270" reaches the list split at every comma.
+TEST(Params, NamedItemsSplitAtCommasAreJoinedAgain) {
+  EXPECT_EQ(rejoin_named_items({"a:0", "1.2", "2", "180", "b:2", "1.2", "0", "270"}),
+            (std::vector<std::string>{"a:0,1.2,2,180", "b:2,1.2,0,270"}));
+  EXPECT_EQ(rejoin_named_items({"floor:0,0,0"}), (std::vector<std::string>{"floor:0,0,0"}));
+  EXPECT_EQ(rejoin_named_items({"x", "y"}), (std::vector<std::string>{"x,y"}));  // (then refused by the item parser)
+  EXPECT_TRUE(rejoin_named_items({}).empty());
+}

@@ -483,3 +483,30 @@ TEST(SimShift, PeopleComeWorkAndLeaveAndEveryDepartureIsAnEvent) {
     EXPECT_TRUE(e.kind == sim::SimEvent::Kind::Truth || e.kind == sim::SimEvent::Kind::Raw);
   }
 }
+
+// Layouts of a cell: every sensor 2 m from the centre, looking at it.
+TEST(SimSensors, LayoutsPlaceEverySensorRoundTheCellLookingAtIt) {
+  const auto angle_of = [](const sim::SensorConfig& s) { return std::atan2(s.position.x(), s.position.z()) * 180.0 / kPi; };
+  for (const auto& name : sim::layout_names()) {
+    SCOPED_TRACE(name);
+    const int n = name == "corners" ? 4 : 5;
+    const auto sensors = sim::layout_sensors(name, n);
+    ASSERT_EQ(sensors.size(), static_cast<std::size_t>(n));
+    for (const auto& s : sensors) {
+      EXPECT_NEAR(Eigen::Vector2d(s.position.x(), s.position.z()).norm(), 2.0, 1e-9);
+      // The optical axis (+z of the sensor) points at the centre.
+      const Eigen::Vector3d axis = s.world_from_sensor().linear() * Eigen::Vector3d::UnitZ();
+      const Eigen::Vector3d to_centre = Eigen::Vector3d(-s.position.x(), 0, -s.position.z()).normalized();
+      EXPECT_GT(axis.dot(to_centre), 0.999);
+    }
+  }
+  const auto ring = sim::layout_sensors("ring", 6);
+  for (int i = 0; i < 6; ++i) EXPECT_NEAR(std::remainder(angle_of(ring[static_cast<std::size_t>(i)]) - 60.0 * i, 360.0), 0.0, 1e-9);
+  const auto side = sim::layout_sensors("one_side", 3);
+  EXPECT_NEAR(angle_of(side[0]), -45.0, 1e-9);
+  EXPECT_NEAR(angle_of(side[1]), 0.0, 1e-9);
+  EXPECT_NEAR(angle_of(side[2]), 45.0, 1e-9);
+  EXPECT_EQ(sim::layout_sensors("quarters", 3)[2].position, sim::default_sensors(3)[2].position);
+  EXPECT_THROW(sim::layout_sensors("corners", 3), std::invalid_argument);
+  EXPECT_THROW(sim::layout_sensors("star", 3), std::invalid_argument);
+}

@@ -88,13 +88,7 @@ GestureComponent::GestureComponent(runtime::Context& ctx, const runtime::Params&
   options_.still_speed = params.get<double>("still_speed");
   options_.min_raise = params.get<double>("min_raise_deg");
   options_.surfaces.clear();
-  // On a command line a list is split at commas, which also splits "name:x,y,z":
-  // a piece without a name (no ':') continues the one before it.
-  std::vector<std::string> surfaces;
-  for (const auto& piece : params.get<std::vector<std::string>>("surfaces")) {
-    if (piece.find(':') == std::string::npos && !surfaces.empty()) surfaces.back() += "," + piece;
-    else surfaces.push_back(piece);
-  }
+  const auto surfaces = runtime::rejoin_named_items(params.get<std::vector<std::string>>("surfaces"));
   for (const auto& s : surfaces) options_.surfaces.push_back(parse_surface(s));
   const auto& labels = classifier_.labels();
   if (std::find(labels.begin(), labels.end(), options_.point_label) == labels.end())

@@ -229,4 +229,13 @@ RawParam parse_param_assignment(const std::string& text, const std::string& orig
   return RawParam{text.substr(0, eq), text.substr(eq + 1), origin};
 }
 
+std::vector<std::string> rejoin_named_items(const std::vector<std::string>& pieces) {
+  std::vector<std::string> items;
+  for (const auto& piece : pieces) {
+    if (piece.find(':') == std::string::npos && !items.empty()) items.back() += "," + piece;
+    else items.push_back(piece);
+  }
+  return items;
+}
+
 }  // namespace skelgraph::runtime

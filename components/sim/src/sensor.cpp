@@ -30,6 +30,36 @@ std::vector<SensorConfig> default_sensors(int count, double distance) {
   return out;
 }
 
+const std::vector<std::string>& layout_names() {
+  static const std::vector<std::string> names{"quarters", "ring", "one_side", "corners"};
+  return names;
+}
+
+std::vector<SensorConfig> layout_sensors(const std::string& layout, int count, double distance) {
+  if (layout == "quarters") return default_sensors(count, distance);
+  if (count < 1 || count > 16) throw std::invalid_argument("sensor count must be 1-16");
+  std::vector<double> angles;  // degrees round the cell from +z, towards +x
+  if (layout == "ring") {
+    for (int i = 0; i < count; ++i) angles.push_back(360.0 * i / count);
+  } else if (layout == "one_side") {
+    for (int i = 0; i < count; ++i) angles.push_back(count == 1 ? 0.0 : -45.0 + 90.0 * i / (count - 1));
+  } else if (layout == "corners") {
+    if (count != 4) throw std::invalid_argument("layout 'corners' has 4 sensors, not " + std::to_string(count));
+    angles = {45.0, 135.0, 225.0, 315.0};
+  } else {
+    std::string all;
+    for (const auto& n : layout_names()) all += (all.empty() ? "" : ", ") + n;
+    throw std::invalid_argument("unknown sensor layout '" + layout + "' (expected one of: " + all + ")");
+  }
+  auto out = default_sensors(count, distance);  // ids and clock offsets
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const double a = angles[i] * M_PI / 180.0;
+    out[i].position = Eigen::Vector3d(distance * std::sin(a), 1.2, distance * std::cos(a));
+    out[i].yaw = a + M_PI;
+  }
+  return out;
+}
+
 SensorConfig parse_sensor(const std::string& spec, const SensorConfig& defaults) {
   const auto bad = [&](const std::string& why) {
     return std::invalid_argument("sensor '" + spec + "': " + why + " (expected id:x,y,z,yaw_deg[,pitch_deg])");

@@ -20,7 +20,11 @@ void add_sim_params(runtime::ParamSchema& schema) {
       .add_double("work_s", 20.0, "shift: mean time each person works at a place, s", 1.0, 3600.0)
       .add_string("profile", "nite", "tracker model", TrackerProfile::names())
       .add_double("noise_scale", 1.0, "scale of the tracker's random errors (0: none)", 0.0, 10.0)
-      .add_int("sensor_count", 2, "default sensors, 90 degrees apart around the cell (ignored when 'sensors' is set)", 1, 16)
+      .add_int("sensor_count", 2, "sensors of the layout (ignored when 'sensors' is set)", 1, 16)
+      .add_string("layout", "quarters",
+                  "where the sensors are, 2 m round the cell looking at it: quarters (90 degrees apart, then the 45s), "
+                  "ring (evenly), one_side (over the quarter circle in front), corners (4)",
+                  layout_names())
       .add_string_list("sensors", {}, "sensor poses 'id:x,y,z,yaw_deg[,pitch_deg]' (yaw 180 looks along -z)")
       .add_double("truth_rate", 30.0, "ground-truth rate, Hz", 1.0, 1000.0)
       .add_double("drop_probability", 0.01, "chance that a sensor frame is lost", 0.0, 0.9)
@@ -45,9 +49,9 @@ SimConfig sim_config_from(const runtime::Params& params) {
   c.profile = params.get<std::string>("profile");
   c.noise_scale = params.get<double>("noise_scale");
   c.truth_rate_hz = params.get<double>("truth_rate");
-  const auto specs = params.get<std::vector<std::string>>("sensors");
+  const auto specs = runtime::rejoin_named_items(params.get<std::vector<std::string>>("sensors"));
   if (specs.empty()) {
-    c.sensors = default_sensors(static_cast<int>(params.get<std::int64_t>("sensor_count")));
+    c.sensors = layout_sensors(params.get<std::string>("layout"), static_cast<int>(params.get<std::int64_t>("sensor_count")));
   } else {
     c.sensors.clear();
     const auto defaults = default_sensors(static_cast<int>(specs.size()));

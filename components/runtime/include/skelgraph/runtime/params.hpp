@@ -88,4 +88,8 @@ class ParamSchema {
 // Parses "key=value" (value "a,b" for lists stays text; the schema splits it).
 RawParam parse_param_assignment(const std::string& text, const std::string& origin);
 
+// A list of "name:a,b,c" items given on a command line comes split at every
+// comma: a piece without a ':' continues the item before it.
+std::vector<std::string> rejoin_named_items(const std::vector<std::string>& pieces);
+
 }  // namespace skelgraph::runtime

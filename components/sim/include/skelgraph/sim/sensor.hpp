@@ -36,6 +36,16 @@ struct SensorConfig {
 // own clock offset (0, +12, -7, +20 ms, ...).
 std::vector<SensorConfig> default_sensors(int count = 2, double distance = 2.0);
 
+// Sensor layouts of a cell, `count` sensors `distance` m from its centre,
+// 1.2 m high, each looking at it (sensor1 on +z, facing the first person):
+//   quarters  default_sensors: 90 degrees apart (the thesis's pair), then the 45-degree places between
+//   ring      evenly round the cell, 360/count degrees apart
+//   one_side  over the quarter circle in front of the person (from -45 to +45 degrees)
+//   corners   the four corners of the cell (count must be 4): at 45, 135, 225, 315 degrees
+// Throws std::invalid_argument for an unknown name or a count it cannot take.
+std::vector<SensorConfig> layout_sensors(const std::string& layout, int count, double distance = 2.0);
+const std::vector<std::string>& layout_names();
+
 // "id:x,y,z,yaw_deg[,pitch_deg]" (yaw 180 looks along -z). Throws
 // std::invalid_argument naming what is wrong.
 SensorConfig parse_sensor(const std::string& spec, const SensorConfig& defaults = {});
