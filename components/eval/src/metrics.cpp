@@ -150,13 +150,16 @@ constexpr Bone kBones[] = {{"neck-head", JointId::Neck, JointId::Head},
                            {"shoulders", JointId::LeftShoulder, JointId::RightShoulder}};
 }  // namespace
 
+bool upper_body_complete(const skeleton::Skeleton& s) {
+  for (std::size_t j = 0; j < skeleton::kJointCount; ++j) {
+    if (group_of(skeleton::joint_at(j)) >= 0 && s.joints[j].confidence < skeleton::kTracked) return false;
+  }
+  return true;
+}
+
 void Steadiness::add(const skeleton::Skeleton& s) {
   ++frames_;
-  bool complete = true;
-  for (std::size_t j = 0; j < skeleton::kJointCount; ++j) {
-    if (group_of(skeleton::joint_at(j)) >= 0 && s.joints[j].confidence < skeleton::kTracked) complete = false;
-  }
-  if (complete) ++complete_;
+  if (upper_body_complete(s)) ++complete_;
   for (const auto& b : kBones) {
     if (s[b.a].confidence < skeleton::kTracked || s[b.b].confidence < skeleton::kTracked) continue;
     const double len = (s[b.a].position - s[b.b].position).norm();

@@ -179,7 +179,9 @@ struct Evaluator::Impl {
     const std::int64_t at = tick - options.fuser.delay_ns;
     truth.forget_before(at - 1'000'000'000);
     const bool truth_here = truth.covers(at);
-    for (auto& lane : lanes) {
+    std::vector<bool> complete(lanes.size(), false);  // a skeleton of the lane has the whole upper body at confidence 1
+    for (std::size_t i = 0; i < lanes.size(); ++i) {
+      auto& lane = lanes[i];
       std::vector<skeleton::Skeleton> fused;
       if (lane.recorded.empty()) {
         fused = lane.fuser.fuse(tick);
@@ -199,9 +201,19 @@ struct Evaluator::Impl {
         for (const auto& f : fused) sink(lane.method, f);
       }
       if (!fused.empty()) ++lane.score.with_output;
-      for (const auto& f : fused) lane.score.steadiness.add(f);
+      for (const auto& f : fused) {
+        lane.score.steadiness.add(f);
+        complete[i] = complete[i] || upper_body_complete(f);
+      }
       if (!truth_here) continue;
       score(lane, fused, at);
+    }
+    bool any_single = false;
+    for (std::size_t i = 0; i < lanes.size(); ++i) any_single = any_single || (lanes[i].kind == Lane::Kind::Single && complete[i]);
+    if (!any_single) return;
+    for (std::size_t i = 0; i < lanes.size(); ++i) {
+      ++lanes[i].score.ticks_single_complete;
+      if (complete[i]) ++lanes[i].score.complete_when_single;
     }
   }
 

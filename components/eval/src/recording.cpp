@@ -49,6 +49,7 @@ nlohmann::json stream_json(const StreamScore& s) {
           {"after_calibration_mean_error_cm", num(s.after_calibration.mean_error_cm())},
           {"compensated_mean_error_cm", num(s.compensated.mean_error_cm())},
           {"upper_body_complete_pct", s.steadiness.upper_body_complete_pct()},
+          {"upper_body_complete_when_a_single_sensor_is_pct", s.complete_when_single_pct()},
           {"bone_length_sd_cm", num(s.steadiness.mean_bone_sd_cm())},
           {"ticks", s.ticks},
           {"ticks_with_output", s.with_output}};

@@ -65,6 +65,9 @@ class TruthTimeline {
   std::map<std::uint32_t, std::vector<std::pair<std::int64_t, skeleton::Skeleton>>> by_person_;
 };
 
+// Every joint of the evaluated groups (head to hands) at confidence 1.
+bool upper_body_complete(const skeleton::Skeleton& s);
+
 // Bone-length steadiness, no truth needed: for each upper-body bone, the
 // standard deviation of its length over the frames where both ends have
 // confidence 1, within each person (people's bones differ; the spread of

@@ -62,6 +62,13 @@ struct StreamScore {
   Accumulator compensated;        // after the calibration segment, with per-joint offsets removed
   Steadiness steadiness;
   std::uint64_t ticks = 0, with_output = 0;
+  // Ticks on which some single sensor had the whole upper body at confidence
+  // 1, and of those, the ticks this stream had it too: how much of what any
+  // one sensor tracks the stream keeps.
+  std::uint64_t ticks_single_complete = 0, complete_when_single = 0;
+  double complete_when_single_pct() const {
+    return ticks_single_complete > 0 ? 100.0 * static_cast<double>(complete_when_single) / static_cast<double>(ticks_single_complete) : 0.0;
+  }
   std::vector<TracePoint> trace;  // with OfflineOptions::trace
 };
 
