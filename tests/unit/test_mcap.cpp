@@ -137,6 +137,42 @@ TEST(Mcap, DamageIsFoundAndNamedWithItsOffset) {
   EXPECT_THROW(Reader(bad, "summary.mcap").validate(), McapError);
 }
 
+// The summary and its indexes are optional (a file read by scanning is
+// valid); indexes that are there must match the data.
+TEST(Mcap, IndexesThatContradictTheChunksAreADefect) {
+  const auto path = write_file("indexed.mcap", Compression::None, 200);
+  const auto good = slurp(path);
+  ASSERT_NO_THROW(Reader(good, "good.mcap").validate());
+  const auto u64 = [](const std::string& b, std::size_t at) {
+    std::uint64_t v = 0;
+    for (int k = 7; k >= 0; --k) v = (v << 8) | static_cast<unsigned char>(b[at + static_cast<std::size_t>(k)]);
+    return v;
+  };
+  // Footer: opcode, length, summary start, summary offset start, summary CRC, then the magic.
+  const std::size_t footer = good.size() - 8 - (1 + 8 + 8 + 8 + 4);
+  const auto summary_start = u64(good, footer + 1 + 8);
+  ASSERT_GT(summary_start, 0u);
+  // The first chunk index in the summary: move the chunk it points at by one byte.
+  std::size_t at = summary_start;
+  while (at < footer && good[at] != '\x08') at += 1 + 8 + u64(good, at + 1);
+  ASSERT_LT(at, footer) << "no chunk index";
+  std::string bad = good;
+  const std::size_t offset_field = at + 1 + 8 + 8 + 8;  // after message start and end times
+  bad[offset_field] = static_cast<char>(bad[offset_field] + 1);
+  for (int k = 0; k < 4; ++k) bad[footer + 1 + 8 + 8 + 8 + static_cast<std::size_t>(k)] = 0;  // summary CRC: none
+  try {
+    Reader(bad, "moved.mcap").validate();
+    FAIL() << "a chunk index pointing beside its chunk went unnoticed";
+  } catch (const McapError& e) {
+    EXPECT_NE(std::string(e.what()).find("chunk indexes do not match the chunks in the file"), std::string::npos) << e.what();
+    ASSERT_TRUE(e.offset().has_value()) << e.what();
+    EXPECT_EQ(*e.offset(), at) << "the offset of the index record that is wrong: " << e.what();
+  }
+  EXPECT_EQ(Reader(bad, "moved.mcap").summary().message_count, Reader(good, "good.mcap").summary().message_count);
+  const auto s = Reader(good, "good.mcap").summary();
+  EXPECT_TRUE(s.has_chunk_indexes && s.has_statistics && s.has_message_indexes);
+}
+
 TEST(Mcap, EveryTruncationIsAClearErrorNeverACrash) {
   const auto good = slurp(write_file("trunc.mcap", Compression::Lz4, 60, 512));
   for (std::size_t n = 0; n < good.size(); ++n) {

@@ -61,7 +61,8 @@ class AckTally {
   std::set<std::uint32_t> sessions_;
 };
 
-int info(const std::string& file, bool json) {
+// What one recording holds (the `bag info --json` object).
+nlohmann::json info_of(const std::string& file) {
   const mcap::Reader reader = user_input([&] { return mcap::Reader(file); });
   std::string problem;
   try {
@@ -114,6 +115,14 @@ int info(const std::string& file, bool json) {
   }
   nlohmann::json metadata = nlohmann::json::array();
   for (const auto& m : s.metadata) metadata.push_back({{"name", m.name}, {"values", m.values}});
+  // Indexes are optional (the MCAP specification): what is missing was read by scanning. Information, not a defect.
+  nlohmann::json notes = nlohmann::json::array();
+  if (!s.indexed) notes.push_back("no summary section: everything read by scanning the data section");
+  if (s.indexed && !s.has_statistics) notes.push_back("no statistics record: counts from scanning");
+  if (s.chunk_count > 0 && !s.has_chunk_indexes) notes.push_back("no chunk indexes: chunks found by scanning");
+  if (s.chunk_count > 0 && !s.has_message_indexes) notes.push_back("no message indexes: chunks read whole");
+  if (s.attachment_count > 0 && !s.has_attachment_indexes) notes.push_back("no attachment index: attachments found by scanning");
+  if (!s.metadata.empty() && !s.has_metadata_indexes) notes.push_back("no metadata index: metadata found by scanning");
   const nlohmann::json out{{"file", file},
                            {"valid", problem.empty()},
                            {"problem", problem},
@@ -121,6 +130,16 @@ int info(const std::string& file, bool json) {
                            {"library", s.library},
                            {"messages", s.message_count},
                            {"chunks", s.chunk_count},
+                           {"attachments", s.attachment_count},
+                           {"indexes",
+                            {{"summary", s.indexed},
+                             {"statistics", s.has_statistics},
+                             {"chunk", s.has_chunk_indexes},
+                             {"message", s.has_message_indexes},
+                             {"attachment", s.has_attachment_indexes},
+                             {"metadata", s.has_metadata_indexes},
+                             {"summary_offsets", s.has_summary_offsets}}},
+                           {"notes", notes},
                            {"start_ns", s.message_start_time},
                            {"end_ns", s.message_end_time},
                            {"duration_s", duration},
@@ -133,35 +152,48 @@ int info(const std::string& file, bool json) {
                            {"ticks_with_frames_of", ticks_with},
                            {"clock_offsets", clocks},
                            {"metadata", metadata}};
-  if (json) {
-    std::printf("%s\n", out.dump(2).c_str());
-  } else {
-    std::printf("file:      %s (%llu bytes, %s)\n", file.c_str(), static_cast<unsigned long long>(reader.size()),
-                problem.empty() ? "valid" : ("INVALID: " + problem).c_str());
-    std::printf("duration:  %.3f s, %llu messages in %llu chunks, %llu ticks\n", duration,
-                static_cast<unsigned long long>(s.message_count), static_cast<unsigned long long>(s.chunk_count),
-                static_cast<unsigned long long>(ticks));
-    for (const auto& t : topics) {
-      std::printf("  %-32s %-34s %8llu msgs %8.2f Hz\n", t["topic"].get<std::string>().c_str(),
-                  t["type"].get<std::string>().c_str(), t["count"].get<unsigned long long>(), t["rate_hz"].get<double>());
-    }
-    for (const auto& [h, n] : acks.by_host()) std::printf("  host %-20s %8llu ticks acked\n", h.c_str(), static_cast<unsigned long long>(n));
-    for (const auto& [h, c] : clocks) {
-      std::printf("  clock %-19s offset %+.3f ms, drift %+.1f ppm, rtt %.3f ms\n", h.c_str(),
-                  c["offset_ns"].get<double>() * 1e-6, c["drift_ppm"].get<double>(), c["rtt_ns"].get<double>() * 1e-6);
-    }
-    for (const auto& [k, n] : per_sensor) std::printf("  skeletons %-40s %8llu\n", k.c_str(), static_cast<unsigned long long>(n));
-    for (const auto& [k, n] : ticks_with) {
-      std::printf("  frames at ticks %-34s %8llu of %llu ticks\n", k.c_str(), static_cast<unsigned long long>(n),
-                  static_cast<unsigned long long>(tick_records));
-    }
-    for (const auto& m : s.metadata) {
-      std::printf("  metadata %s:", m.name.c_str());
-      for (const auto& [k, v] : m.values) std::printf(" %s=%s", k.c_str(), v.c_str());
-      std::printf("\n");
-    }
+  return out;
+}
+
+void print_info(const nlohmann::json& d) {
+  const auto u = [](const nlohmann::json& v) { return static_cast<unsigned long long>(v.get<std::uint64_t>()); };
+  std::printf("file:      %s (%llu bytes, %s)\n", d["file"].get<std::string>().c_str(), u(d["size_bytes"]),
+              d["valid"].get<bool>() ? "valid" : ("INVALID: " + d["problem"].get<std::string>()).c_str());
+  std::printf("duration:  %.3f s, %llu messages in %llu chunks, %llu attachments, %llu ticks\n", d["duration_s"].get<double>(),
+              u(d["messages"]), u(d["chunks"]), u(d["attachments"]), u(d["ticks"]));
+  for (const auto& n : d["notes"]) std::printf("note:      %s\n", n.get<std::string>().c_str());
+  for (const auto& t : d["topics"]) {
+    std::printf("  %-32s %-34s %8llu msgs %8.2f Hz\n", t["topic"].get<std::string>().c_str(),
+                t["type"].get<std::string>().c_str(), u(t["count"]), t["rate_hz"].get<double>());
   }
-  return problem.empty() ? 0 : 1;
+  for (const auto& [h, n] : d["ticks_acked_by_host"].items()) std::printf("  host %-20s %8llu ticks acked\n", h.c_str(), u(n));
+  for (const auto& [h, c] : d["clock_offsets"].items()) {
+    std::printf("  clock %-19s offset %+.3f ms, drift %+.1f ppm, rtt %.3f ms\n", h.c_str(),
+                c["offset_ns"].get<double>() * 1e-6, c["drift_ppm"].get<double>(), c["rtt_ns"].get<double>() * 1e-6);
+  }
+  for (const auto& [k, n] : d["skeletons_per_sensor"].items()) std::printf("  skeletons %-40s %8llu\n", k.c_str(), u(n));
+  for (const auto& [k, n] : d["ticks_with_frames_of"].items()) {
+    std::printf("  frames at ticks %-34s %8llu of %llu ticks\n", k.c_str(), u(n), u(d["tick_records"]));
+  }
+  for (const auto& m : d["metadata"]) {
+    std::printf("  metadata %s:", m["name"].get<std::string>().c_str());
+    for (const auto& [k, v] : m["values"].items()) std::printf(" %s=%s", k.c_str(), v.get<std::string>().c_str());
+    std::printf("\n");
+  }
+}
+
+// One file: its object (--json) or text; several: an array, or each in turn. Exit 1 if any is damaged.
+int info(const std::vector<std::string>& files, bool json) {
+  nlohmann::json all = nlohmann::json::array();
+  bool valid = true;
+  for (const auto& f : files) {
+    auto d = info_of(f);
+    valid = valid && d["valid"].get<bool>();
+    if (!json) print_info(d);
+    all.push_back(std::move(d));
+  }
+  if (json) std::printf("%s\n", (files.size() == 1 ? all[0] : all).dump(2).c_str());
+  return valid ? 0 : 1;
 }
 
 int import(playback::Format format, const std::vector<std::string>& files, const playback::ReadOptions& opt,
@@ -495,10 +527,11 @@ void add_bag_command(CLI::App& app, GlobalOptions& g, Action& run) {
     };
   });
 
-  auto* i = bag->add_subcommand("info", "What a recording holds: duration, topics with counts and rates, ticks, sessions, metadata; exit 1 if the file is damaged");
-  i->add_option("file", o->file, "MCAP file")->required()->check(CLI::ExistingFile);
-  i->add_flag("--json", o->json, "machine-readable output");
-  i->callback([o, &run] { run = [o] { return info(o->file, o->json); }; });
+  auto* i = bag->add_subcommand("info", "What a recording holds: duration, topics with counts and rates, ticks, sessions, "
+                                        "metadata, attachments, which indexes it has; exit 1 if a file is damaged");
+  i->add_option("files", o->files, "MCAP file(s)")->required()->check(CLI::ExistingFile);
+  i->add_flag("--json", o->json, "machine-readable output (several files: an array)");
+  i->callback([o, &run] { run = [o] { return info(o->files, o->json); }; });
 
   auto* im = bag->add_subcommand("import", "Data-set files (the playback formats) into an MCAP recording on skelgraph/skeleton/raw");
   im->add_option("format", o->format, "file format")->required()->check(CLI::IsMember(playback::format_names()));

@@ -502,6 +502,7 @@ struct Reader::Scan {
   std::uint64_t summary_start = 0, summary_offset_start = 0;
   std::vector<std::pair<std::uint64_t, std::uint64_t>> chunk_records;  // offset, length
   std::vector<std::pair<std::uint64_t, std::uint64_t>> indexed_chunks;  // from the summary
+  std::vector<std::uint64_t> chunk_index_at;                             // where each of those index records is
   std::optional<std::uint64_t> stats_messages;
 };
 
@@ -668,6 +669,14 @@ void Reader::scan(Scan& s, bool strict) const {
       break;
     }
     if (op == kHeader || op == kFooter) throw McapError(name_ + ": unexpected record 0x0" + std::to_string(op) + " in the data section", at);
+    if (op == kMessageIndex) {
+      s.summary.has_message_indexes = true;
+      continue;
+    }
+    if (op == kAttachment) {
+      ++s.summary.attachment_count;
+      continue;
+    }
     if (op == kChunk) {
       const std::string raw = read_chunk(r, at, name_);
       In inner(raw, 0, name_);
@@ -702,12 +711,21 @@ void Reader::scan(Scan& s, bool strict) const {
     In r = next_record(&op, &at);
     if (op == kStatistics) {
       s.stats_messages = r.u64("statistics message count");
+      s.summary.has_statistics = true;
+    } else if (op == kAttachmentIndex) {
+      s.summary.has_attachment_indexes = true;
+    } else if (op == kMetadataIndex) {
+      s.summary.has_metadata_indexes = true;
+    } else if (op == kSummaryOffset) {
+      s.summary.has_summary_offsets = true;
     } else if (op == kChunkIndex) {
+      s.summary.has_chunk_indexes = true;
       r.u64("chunk index start");
       r.u64("chunk index end");
       const auto off = r.u64("chunk index offset");
       const auto len = r.u64("chunk index length");
       s.indexed_chunks.emplace_back(off, len);
+      s.chunk_index_at.push_back(at);
     } else if (op == kFooter) {
       throw McapError(name_ + ": footer before the end of the file", at);
     }
@@ -736,8 +754,24 @@ void Reader::validate() const {
     throw McapError(name_ + ": statistics count " + std::to_string(*s.stats_messages) + " messages, the file has " +
                     std::to_string(s.messages));
   }
-  if (s.summary.indexed && s.indexed_chunks != s.chunk_records) {
-    throw McapError(name_ + ": chunk indexes do not match the chunks in the file");
+  // Chunk indexes are optional; those a file has must match its chunks.
+  if (s.summary.has_chunk_indexes && s.indexed_chunks != s.chunk_records) {
+    // Name the first that disagree: an index pointing beside its chunk, or a chunk no index names.
+    std::size_t i = 0;
+    while (i < s.indexed_chunks.size() && i < s.chunk_records.size() && s.indexed_chunks[i] == s.chunk_records[i]) ++i;
+    const auto where = [](const std::pair<std::uint64_t, std::uint64_t>& c) {
+      return "byte " + std::to_string(c.first) + ", " + std::to_string(c.second) + " bytes";
+    };
+    if (i < s.indexed_chunks.size()) {
+      throw McapError(name_ + ": chunk indexes do not match the chunks in the file: index " + std::to_string(i + 1) +
+                          " names a chunk at " + where(s.indexed_chunks[i]) + ", the file's chunk " + std::to_string(i + 1) +
+                          (i < s.chunk_records.size() ? " is at " + where(s.chunk_records[i]) : std::string(" does not exist")),
+                      s.chunk_index_at[i]);
+    }
+    throw McapError(name_ + ": chunk indexes do not match the chunks in the file: chunk " + std::to_string(i + 1) + " at " +
+                        where(s.chunk_records[i]) + " has no index (" + std::to_string(s.indexed_chunks.size()) + " indexes, " +
+                        std::to_string(s.chunk_records.size()) + " chunks)",
+                    s.chunk_records[i].first);
   }
 }
 

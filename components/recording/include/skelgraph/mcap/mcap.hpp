@@ -131,7 +131,12 @@ struct Summary {
   std::uint64_t message_start_time = 0, message_end_time = 0;
   std::map<std::uint16_t, std::uint64_t> channel_message_counts;
   std::vector<Metadata> metadata;
+  std::uint64_t attachment_count = 0;
   bool indexed = false;  // had a summary section
+  // What the summary section (and the data section's message indexes) hold:
+  // all optional; what is missing is read by scanning the data section.
+  bool has_statistics = false, has_chunk_indexes = false, has_message_indexes = false,
+       has_attachment_indexes = false, has_metadata_indexes = false, has_summary_offsets = false;
 };
 
 class Reader {
