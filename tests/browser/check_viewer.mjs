@@ -40,8 +40,10 @@ try {
   }
   const b = await stats();
   const dt = (Date.now() - t0) / 1000;
-  out.received_per_s = (b.framesReceived - a.framesReceived) / dt;
-  out.drawn_per_s = (b.framesDrawn - a.framesDrawn) / dt;
+  out.received = b.framesReceived - a.framesReceived;
+  out.drawn = b.framesDrawn - a.framesDrawn;
+  out.received_per_s = out.received / dt;
+  out.drawn_per_s = out.drawn / dt;
   out.page_fps = b.fps;
   out.sensors = b.sensors;
   out.streams = b.streams;  // what the viewer received: kind and rate per stream

@@ -3,8 +3,11 @@
 # sensors of one cell (in step with the wall clock), the fusion component fuses
 # them (a person standing in front of sensor 1 moving their arms, so sensor 1
 # alone still sees them); the second sensor's process is killed and fusion
-# goes on at full rate with its status DEGRADED; a new process for that sensor
-# brings it back.
+# goes on fusing every frame of the first, its status DEGRADED; a new process
+# for that sensor brings it back. Counts, not rates (a rate depends on what
+# else the machine runs; bench/viewer_load.sh measures fusion's live rate):
+# between two of fusion's status reports, one fused skeleton per frame of each
+# live sensor.
 source "$(dirname "$0")/lib.sh"
 
 cam() {  # cam NAME SENSOR [extra -p ...]
@@ -36,17 +39,32 @@ sys.exit(1)' "$1" >"$WORK/status_$1.json" && return 0
   done
   return 1
 }
-# rate: the fused output's rate over 3 s; up to three windows until one is
-# 27-33 Hz (the simulated trackers lose the walking person for about half a
-# second when the walk starts over: a clean-clone run read 24.3 Hz once).
-rate() {
-  local r=0
-  for i in 1 2 3; do
-    "$SKELGRAPH" topic hz skelgraph/skeleton/fused --window 3 --json --timeout 10 >"$WORK/hz_$1_$i.json" || return 1
-    r=$(json_get "$WORK/hz_$1_$i.json" 'round(d["rate_hz"], 1)')
-    python3 -c "import sys; sys.exit(0 if 27 <= float(sys.argv[1]) <= 33 else 1)" "$r" && break
+# keeps_up NAME SENSORS: between two of fusion's status reports about 3 s apart
+# (its own counts: no reader of ours in between to lose samples on a busy
+# machine), one fused skeleton per step of the SENSORS live sensors: fused out
+# over raw in per sensor, 0.8-1.25. Prints "fused/frames".
+keeps_up() {
+  local i
+  for i in 1 2; do
+    { timeout 8 "$SKELGRAPH" topic echo skelgraph/status --json --timeout 5 2>/dev/null || true; } | python3 -c '
+import json, sys
+for line in sys.stdin:
+    d = json.loads(line)["data"]
+    if d["component_name"] == "fusion":
+        print(json.dumps(d)); sys.exit(0)
+sys.exit(1)' >"$WORK/keeps_up_$1_$i.json" || return 1
+    [ "$i" = 1 ] && sleep 3
   done
-  echo "$r"
+  python3 - "$WORK/keeps_up_$1_1.json" "$WORK/keeps_up_$1_2.json" "$2" <<'PY'
+import json, sys
+a, b = (json.load(open(p)) for p in sys.argv[1:3])
+sensors = int(sys.argv[3])
+count = lambda d, topic, out: next(t["count"] for t in d["topics"] if t["topic"] == topic and t["is_output"] == out)
+fused = count(b, "skelgraph/skeleton/fused", True) - count(a, "skelgraph/skeleton/fused", True)
+frames = (count(b, "skelgraph/skeleton/raw", False) - count(a, "skelgraph/skeleton/raw", False)) / sensors
+print(f"{fused}/{frames:.0f}")
+sys.exit(0 if frames >= 30 and 0.8 <= fused / frames <= 1.25 else 1)
+PY
 }
 
 status OK || fail "fusion never OK: $(tail -5 "$WORK/fusion.err")"
@@ -58,9 +76,8 @@ assert all(r["frame_id"] == "world" and r["sensor_id"] == "fused" for r in rows)
 masks = [max(j["sensor_mask"] for j in r["joints"]) for r in rows]
 assert max(masks) == 3, masks   # both sensors contribute
 PY
-before=$(rate both)
-python3 -c "import sys; sys.exit(0 if 27 <= float(sys.argv[1]) <= 33 else 1)" "$before" || fail "fused rate with both sensors: $before Hz"
-ok "fusing two sensor processes: $before Hz, both sensors in the joints"
+before=$(keeps_up both 2) || fail "fused skeletons over frames per sensor with both sensors: $before"
+ok "fusing two sensor processes: $before fused skeletons per frame of each sensor, both sensors in the joints"
 
 wait "$rec" || fail "recorder: $(tail -3 "$WORK/rec.err")"
 # The recording of both sensor processes, fused and scored offline.
@@ -92,16 +109,14 @@ kill -KILL "$cam2"
 wait "$cam2" 2>/dev/null || true
 status DEGRADED || fail "fusion did not flag the silent sensor: $(tail -5 "$WORK/fusion.err")"
 json_check "$WORK/status_DEGRADED.json" '"sensor2" in d["message"]'
-during=$(rate dropped)
-python3 -c "import sys; sys.exit(0 if 27 <= float(sys.argv[1]) <= 33 else 1)" "$during" || fail "fused rate without sensor2: $during Hz"
-ok "sensor2's process killed: DEGRADED ($(json_get "$WORK/status_DEGRADED.json" 'd["message"]')), still $during Hz"
+during=$(keeps_up dropped 1) || fail "fused skeletons over sensor1's frames without sensor2: $during"
+ok "sensor2's process killed: DEGRADED ($(json_get "$WORK/status_DEGRADED.json" 'd["message"]')), still one fused per frame of sensor1: $during"
 
 cam cam2b sensor2 -p publish_truth=false
 cam2b=$!
 status OK || fail "fusion did not take sensor2 back: $(tail -5 "$WORK/fusion.err")"
-after=$(rate back)
-python3 -c "import sys; sys.exit(0 if 27 <= float(sys.argv[1]) <= 33 else 1)" "$after" || fail "fused rate with sensor2 back: $after Hz"
-ok "sensor2 back: OK again, $after Hz"
+after=$(keeps_up back 2) || fail "fused skeletons over frames per sensor with sensor2 back: $after"
+ok "sensor2 back: OK again, $after fused skeletons per frame of each sensor"
 
 kill -INT "$fusion" "$cam1" "$cam2b"
 wait "$fusion" || fail "fusion: $(tail -5 "$WORK/fusion.err")"

@@ -4,11 +4,12 @@
 # `lan` profile (multicast discovery) or `lan-discovery-server` (a Fast DDS
 # discovery server on the fusion host, no multicast at all: counted on the
 # wire): discovery across hosts; fused output at full rate from both sensor
-# hosts; a session recorded on every host and merged by tick; and faults:
-# sensor1's cable pulled for 5 s (everything resumes without restarts, the
-# reliable sync ticks all arrive), 10 % loss and 20 ms delay on it (reliable
-# topics lose nothing, best-effort skeletons degrade gracefully), sensor2's
-# host process killed and restarted (fusion degrades and recovers).
+# hosts; sensor2's host process killed and restarted (fusion degrades and
+# recovers: rediscovery). With multicast also the faults of the wire and a
+# session recorded through them: sensor1's cable pulled for 5 s (everything
+# resumes without restarts, the reliable sync ticks all arrive), 10 % loss and
+# 20 ms delay on it (reliable topics lose nothing, best-effort skeletons
+# degrade gracefully), the session recorded on every host and merged by tick.
 #
 #   lan.sh SKELGRAPH LOSSY_LINK multicast|discovery-server
 source "$(dirname "$0")/lib.sh"
@@ -125,6 +126,10 @@ data=$(tshark -r "$WORK/cell.pcapng" -Y "rtps.sm.id == 0x15" 2>/dev/null | wc -l
 world=$(python3 -c 'import sys; print(open(sys.argv[1], "rb").read().count(b"world"))' "$WORK/cell.pcapng")
 [ "$world" -gt 100 ] || fail "only $world plaintext 'world' frame ids in an unencrypted capture"
 ok "tshark on the switch: $(grep -c / "$WORK/sedp.txt") topics and $(grep -c :: "$WORK/sedp.txt") types named in discovery, $data DATA packets"
+# 2-4, the faults of the wire and the session recorded through them, take about
+# 25 s and do not depend on how the hosts discovered each other: the multicast
+# run only (not indented below: the here-documents are Python).
+if [ "$MODE" = multicast ]; then
 # A session of our own from here on (the launch's own one began before the hosts had met).
 sg fusion sync start --label lan --timeout 10 >/dev/null || fail "sync start"
 
@@ -183,6 +188,7 @@ print("gesture events recorded per host:", n)
 assert n["fusion"] > 0 and n["sensor1"] == n["fusion"] == n["sensor2"], n   # reliable: sensor1 lost none on its bad cable
 PY
 ok "session merged from three hosts: every one of $(json_get "$WORK/stop.json" 'd["tick"]') ticks acked by every host, sensor1's through the cut and the loss"
+fi  # multicast: 2-4
 
 # 5. sensor2's host process killed and started again.
 kill -KILL "$p_sensor2"

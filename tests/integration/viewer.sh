@@ -3,8 +3,11 @@
 # simulated sensors, fusion, viewer) on loopback; Debian's Chromium, driven by
 # Playwright, opens the page; what the page drew is checked against what was
 # published; the same with four sensors (bringup/sim_quad_viewer.yaml); then,
-# on the four-sensor graph, 20 WebSocket clients read for 30 s beside a
-# stalled, a malformed and a reconnecting one, and fusion must keep its rate.
+# on the four-sensor graph, 20 WebSocket clients read for 10 s beside a
+# stalled, a malformed and a reconnecting one: every client gets frames, the
+# stalled one's are dropped, the bad requests are answered, fusion
+# keeps publishing. Counts and content only: the rates and delays under that
+# load are measured by bench/viewer_load.sh.
 #   viewer.sh SKELGRAPH BROWSER_DIR WS_LOAD PUBLISH_GESTURE   (BROWSER_DIR: tests/browser installed by npm)
 # The page's screenshot: $SKELGRAPH_VIEWER_SCREENSHOT, default build/viewer-screenshot.png.
 source "$(dirname "$0")/lib.sh"
@@ -61,8 +64,8 @@ def check(cond, what):
     if not cond: problems.append(what)
 check(not page["page_errors"], f"page errors: {page['page_errors']}")
 check(page["sensors"] == sensors, f"{page['sensors']} sensors drawn, expected {sensors} with frustums")
-check(page["received_per_s"] >= 25, f"page received {page['received_per_s']:.1f} frames/s")
-check(page["drawn_per_s"] >= 15, f"page drew {page['drawn_per_s']:.1f} frames/s ({page['gl']})")
+check(page["received"] >= 10, f"page received {page['received']} frames in its window")
+check(page["drawn"] >= 5, f"page drew {page['drawn']} frames in its window ({page['gl']})")
 compared = missing = 0
 streams = set()
 for snap in page["snapshots"]:
@@ -107,52 +110,41 @@ kill $(jobs -p) 2>/dev/null || true
 wait 2>/dev/null || true
 browser_check bringup/sim_quad_viewer.yaml 4
 
-# Load: 20 clients for 30 s (and the misbehaving ones); fusion's rate before and during.
-# Fusion's rate: the best of three 3 s windows (the simulated trackers lose the
-# person for about half a second when the walk starts over, once every loop).
-rate() {
-  local best=0 r
-  for i in 1 2 3; do
-    "$SKELGRAPH" topic hz skelgraph/skeleton/fused --window 3 --json --timeout 10 >"$WORK/hz_$1_$i.json" || return 1
-    r=$(json_get "$WORK/hz_$1_$i.json" 'round(d["rate_hz"], 1)')
-    best=$(python3 -c "print(max($best, $r))")
-  done
-  echo "$best"
-}
-before=$(rate before)
-"$WS_LOAD" --port "$PORT" --clients 20 --seconds 30 >"$WORK/load.json" &
-load=$!
-sleep 5
-during=$(rate during)
-wait "$load" || fail "ws_load failed"
+# Load: 20 clients for 10 s (and the misbehaving ones); what fusion publishes meanwhile.
+"$SKELGRAPH" topic echo skelgraph/skeleton/fused --json >"$WORK/fused-during-load.jsonl" 2>/dev/null &
+echo_fused=$!
+"$WS_LOAD" --port "$PORT" --clients 20 --seconds 10 >"$WORK/load.json" || fail "ws_load failed"
+kill -INT "$echo_fused"
+wait "$echo_fused" 2>/dev/null || true
 kill -INT "$launch"
 wait "$launch" || fail "the launch did not end cleanly: $(tail -5 "$WORK/sim_quad_viewer-launch.err")"
-python3 - "$WORK" "$before" "$during" <<'PY' || fail "the viewer under load (above)"
+python3 - "$WORK" <<'PY' || fail "the viewer under load (above)"
 import json, sys
-work, before, during = sys.argv[1], float(sys.argv[2]), float(sys.argv[3])
+work = sys.argv[1]
 load = json.load(open(f"{work}/load.json"))
 report = json.load(open(f"{work}/sim_quad_viewer-launch.json"))
 viewer = next(c for c in report["components"] if c["name"] == "viewer")["details"]
+fusion = next(c for c in report["components"] if c["name"] == "fusion")
+fused = sum(1 for _ in open(f"{work}/fused-during-load.jsonl"))
 mis = load["misbehaving"]
 problems = []
 def check(cond, what):
     if not cond: problems.append(what)
-check(during >= 29.0 and during >= before - 1.0, f"fused rate {before} Hz before the load, {during} Hz during it")
 check(load["failed_clients"] == 0, f"{load['failed_clients']} clients failed: {[c['error'] for c in load['per_client'] if c['error']]}")
-check(load["frames_per_s_min"] >= 25, f"slowest client got {load['frames_per_s_min']:.1f} frames/s")
-check(load["delay_ms_late_median_max"] < 100, f"a client's median delay late in the run: {load['delay_ms_late_median_max']:.1f} ms")
-growth = [c["delay_ms_late_median"] - c["delay_ms_early_median"] for c in load["per_client"]]
-check(max(growth) < 20, f"delays grew during the run (late minus early median, ms): {growth}")
+check(len(load["per_client"]) == 20, f"{len(load['per_client'])} clients reported")
+fewest = min(c["frames"] for c in load["per_client"])
+check(fewest >= 30, f"a client got only {fewest} frames in 10 s")
 check(mis.get("errors_answered") == 6 and mis.get("still_open_after_garbage") and mis.get("closed_after_oversize"),
       f"malformed client: {mis}")
-check(mis.get("churned_connections", 0) >= 20, f"reconnecting client: {mis}")
+check(mis.get("churned_connections", 0) >= 5, f"reconnecting client: {mis}")
 check(viewer["peak_clients"] >= 22, f"peak clients {viewer['peak_clients']}")
 check(viewer["frames_dropped"] > 0, "the stalled client's frames were not dropped (buffered?)")
 check(viewer["bad_messages"] >= 7, f"bad messages counted: {viewer['bad_messages']}")
+check(fused >= 30, f"only {fused} fused skeletons published during the load")
+check(fusion["state"] == "OK", f"fusion ended {fusion['state']}: {fusion.get('message')}")
 for p in problems: print("  " + p)
-print(f"ok: {load['clients']} clients for {load['seconds']:.0f} s: {load['frames_per_s_min']:.1f}-{load['frames_per_s_median']:.1f} frames/s "
-      f"each, median delay <= {load['delay_ms_late_median_max']:.1f} ms; fused {before} Hz before, {during} Hz during; "
-      f"{viewer['frames_dropped']} frames dropped for the stalled client, {mis['churned_connections']} reconnects, "
-      f"{viewer['bad_messages']} bad messages answered")
+print(f"ok: {load['clients']} clients for {load['seconds']:.0f} s, none failed, each got {fewest}+ frames; "
+      f"{fused} fused skeletons published meanwhile; {viewer['frames_dropped']} frames dropped for the stalled client, "
+      f"{mis['churned_connections']} reconnects, {viewer['bad_messages']} bad messages answered")
 sys.exit(1 if problems else 0)
 PY

@@ -115,10 +115,19 @@ class Reader : public std::enable_shared_from_this<Reader> {
   std::string error_;
 };
 
-websocket::stream<tcp::socket> connect_sync(net::io_context& ioc, const Options& o) {
+// receive_buffer > 0: the socket's receive buffer, set before connecting so the
+// window it offers is that small from the start.
+websocket::stream<tcp::socket> connect_sync(net::io_context& ioc, const Options& o, int receive_buffer = 0) {
   tcp::resolver resolver(ioc);
   websocket::stream<tcp::socket> ws(ioc);
-  net::connect(ws.next_layer(), resolver.resolve(o.host, o.port));
+  const auto endpoints = resolver.resolve(o.host, o.port);
+  if (receive_buffer > 0) {
+    ws.next_layer().open(endpoints.begin()->endpoint().protocol());
+    ws.next_layer().set_option(net::socket_base::receive_buffer_size(receive_buffer));
+    ws.next_layer().connect(endpoints.begin()->endpoint());
+  } else {
+    net::connect(ws.next_layer(), endpoints);
+  }
   ws.handshake(o.host, "/ws");
   return ws;
 }
@@ -151,11 +160,7 @@ int main(int argc, char** argv) {
   nlohmann::json misc;
   // Stalled: handshakes, then never reads; its socket buffers fill up.
   net::io_context side;
-  auto stalled = connect_sync(side, o);
-  {
-    const int small = 4096;  // a small receive buffer fills sooner
-    setsockopt(stalled.next_layer().native_handle(), SOL_SOCKET, SO_RCVBUF, &small, sizeof(small));
-  }
+  auto stalled = connect_sync(side, o, 4096);  // a small receive buffer fills sooner
   // Malformed: answered with errors, the connection stays usable; an oversized message ends only that connection.
   int errors_answered = 0;
   bool still_open_after_garbage = false, closed_after_oversize = false;
