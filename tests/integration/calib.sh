@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Skeleton-based calibration end to end: a simulated walk exported and
 # imported as a recording, sensor2's pose found from the skeletons (sensor1's
-# taken as known) and checked against the truth; bad input; and the launch
+# taken as known) and checked against the truth; a ring of four sensors
+# calibrated at once (and turning on the spot refused); bad input; and the launch
 # file that feeds fusion from a calibration file publishes in the world frame.
 source "$(dirname "$0")/lib.sh"
 S=$SKELGRAPH
@@ -12,7 +13,7 @@ S=$SKELGRAPH
 "$S" calib skeleton "$WORK/walk.mcap" --ref sensor1 --ref-pose "$WORK/truth.yaml" --clock-search-ms 100 \
   --out "$WORK/calib.yaml" --json >"$WORK/calib.json" 2>"$WORK/calib.err" || fail "calib skeleton: $(cat "$WORK/calib.err")"
 json_check "$WORK/calib.json" 'd[0]["improved"] and len(d[0]["per_joint"]) == 11 and d[0]["inliers"] > 1000'
-# compare_pose TRUTH CALIB MAX_M MAX_DEG: sensor2's pose in CALIB against TRUTH.
+# compare_pose TRUTH CALIB MAX_M MAX_DEG [SENSOR...]: the sensors' poses (default sensor2) in CALIB against TRUTH.
 compare_pose() {
 python3 - "$@" <<'PY'
 import math, re, sys
@@ -24,12 +25,13 @@ def poses(path):
         m = re.match(r"\s*(translation|rotation_xyzw): \[(.*)\]", line)
         if m: cur[m.group(1)] = [float(x) for x in m.group(2).split(",")]
     return out
-t, c = poses(sys.argv[1])["sensor2"], poses(sys.argv[2])["sensor2"]
-dist = math.dist(t["translation"], c["translation"])
-dot = abs(sum(a * b for a, b in zip(t["rotation_xyzw"], c["rotation_xyzw"])))
-angle = math.degrees(2 * math.acos(min(1.0, dot)))
-print("sensor2 against the truth: %.2f cm, %.2f deg" % (dist * 100, angle))
-assert dist < float(sys.argv[3]) and angle < float(sys.argv[4]), (dist, angle)
+for sensor in sys.argv[5:] or ["sensor2"]:
+    t, c = poses(sys.argv[1])[sensor], poses(sys.argv[2])[sensor]
+    dist = math.dist(t["translation"], c["translation"])
+    dot = abs(sum(a * b for a, b in zip(t["rotation_xyzw"], c["rotation_xyzw"])))
+    angle = math.degrees(2 * math.acos(min(1.0, dot)))
+    print("%s against the truth: %.2f cm, %.2f deg" % (sensor, dist * 100, angle))
+    assert dist < float(sys.argv[3]) and angle < float(sys.argv[4]), (sensor, dist, angle)
 PY
 }
 compare_pose "$WORK/truth.yaml" "$WORK/calib.yaml" 0.03 1.0 || fail "skeleton calibration against the truth"
@@ -87,6 +89,32 @@ json_check "$WORK/wrong_square.json" 'd["verdict"].startswith("poor:") and "--sq
 [ "$rc5" -eq 2 ] && grep -q "the 8x6 board (inner corners, columns x rows) was found in 0 of 1 images.*is --board right" "$WORK/bad4.err" ||
   fail "calib intrinsics with the wrong --board: rc $rc5, $(cat "$WORK/bad4.err")"
 ok "wrong board: --square 0.04 for 0.08 gives a poor verdict and exit 1; --board 8x6 for 9x6 says so (exit 2)"
+
+# The whole cell at once: four sensors round the person (one behind), who
+# walks a loop facing where they go; one command, one file, every sensor near
+# its truth. Turning on the spot instead cannot tell the sides apart: the
+# result says so, keeps the previous poses and exits 1; a rough layout
+# (--prior) decides.
+"$S" sim poses "$WORK/ring.yaml" -p layout=ring -p sensor_count=4 >/dev/null
+for scenario in tour 360; do
+  "$S" sim export "$WORK/ring_$scenario" -p layout=ring -p sensor_count=4 -p scenario=$scenario -p repeats=2 >/dev/null 2>&1
+  "$S" bag import generic "$WORK"/ring_$scenario/raw_sensor*.csv --out "$WORK/ring_$scenario.mcap" >/dev/null 2>&1
+done
+"$S" calib skeleton "$WORK/ring_tour.mcap" --ref sensor1 --ref-pose "$WORK/ring.yaml" --out "$WORK/cell.yaml" --json \
+  >"$WORK/cell.json" 2>"$WORK/calib.err" || fail "calib skeleton, whole cell: $(cat "$WORK/calib.err")"
+json_check "$WORK/cell.json" '(d[0]["mode"], d[0]["unplaced"], d[0]["undecided"]) == ("cell", 0, 0) and sorted(s["sensor"] for s in d[0]["sensors"] if s["improved"]) == ["sensor2", "sensor3", "sensor4"]'
+compare_pose "$WORK/ring.yaml" "$WORK/cell.yaml" 0.05 2.0 sensor2 sensor3 sensor4 || fail "the whole cell against the truth"
+ok "the whole cell from one loop: sensor2-4 (sensor3 behind the person) within 5 cm and 2 degrees of the truth"
+set +e
+"$S" calib skeleton "$WORK/ring_360.mcap" --ref sensor1 --out "$WORK/turn.yaml" --json >"$WORK/turn.json" 2>"$WORK/turn.err"; rc=$?
+set -e
+[ "$rc" -eq 1 ] || fail "turning on the spot: rc $rc (expected 1), $(cat "$WORK/turn.err")"
+json_check "$WORK/turn.json" 'd[0]["undecided"] == 3 and all(s["verdict"].startswith("ambiguous:") and not s["improved"] for s in d[0]["sensors"])'
+grep -q "method: unchanged" "$WORK/turn.yaml" || fail "turning on the spot: the poses were not kept"
+"$S" calib skeleton "$WORK/ring_360.mcap" --ref sensor1 --ref-pose "$WORK/ring.yaml" --prior "$WORK/ring.yaml" \
+  --out "$WORK/turn_prior.yaml" --json >"$WORK/turn_prior.json" 2>"$WORK/turn.err" || fail "--prior: $(cat "$WORK/turn.err")"
+compare_pose "$WORK/ring.yaml" "$WORK/turn_prior.yaml" 0.10 3.0 sensor2 sensor3 sensor4 || fail "turning on the spot with --prior"
+ok "turning on the spot: said to be ambiguous, poses kept, exit 1; with --prior every sensor within 10 cm and 3 degrees"
 
 # Bad input: a sensor that is not there, a malformed calibration file, missing intrinsics.
 set +e

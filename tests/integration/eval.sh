@@ -79,7 +79,7 @@ KMT=${SKELGRAPH_DATA_DIR:-$SRC/../shared/data}/kinect-multitrack/Experiments_1_2
 [ -d "$KMT" ] || fail "$KMT is missing: tests read ../shared/data (or SKELGRAPH_DATA_DIR)"
 for rec in Study_12_Kinect_2_Time_5_01_13_PM Study_14_Kinect_2_Time_5_52_45_PM; do
   "$SKELGRAPH" bag import multitrack "$KMT/$rec.csv" --out "$WORK/$rec.mcap" >/dev/null
-  "$SKELGRAPH" calib skeleton --format multitrack "$KMT/$rec.csv" --ref kinect_138_251_213_82 --out "$WORK/$rec.yaml" >/dev/null
+  "$SKELGRAPH" calib skeleton --format multitrack "$KMT/$rec.csv" --ref kinect_138_251_213_82 --prior shared --out "$WORK/$rec.yaml" >/dev/null
   "$SKELGRAPH" eval recording "$WORK/$rec.mcap" --calibration "$WORK/$rec.yaml" --json >"$WORK/$rec.json"
   python3 - "$WORK/$rec.json" <<'PY' || fail "$rec: $(head -c 1500 "$WORK/$rec.json")"
 import json, sys

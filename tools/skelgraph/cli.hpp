@@ -12,6 +12,10 @@
 #include "skelgraph/runtime/dds_config.hpp"
 #include "skelgraph/runtime/launch_file.hpp"
 
+namespace skelgraph::sim {
+struct SimConfig;
+}
+
 namespace skelgraph::cli {
 
 // Bad input from the user (exit code 2); other exceptions exit with 1.
@@ -84,5 +88,11 @@ void add_fuse_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_calib_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_gesture_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_oni_command(CLI::App& app, GlobalOptions& g, Action& run);  // with SKELGRAPH_WITH_OPENNI2
+
+// The simulator's configuration from -p KEY=VALUE assignments (then `extra`,
+// e.g. {"scenario", "walk"}), checked by building a simulation; UsageError
+// naming `what` on bad input. Every offline command that simulates uses it.
+sim::SimConfig sim_config(const std::vector<std::string>& assignments, const char* what,
+                          const std::vector<runtime::RawParam>& extra = {});
 
 }  // namespace skelgraph::cli

@@ -16,12 +16,14 @@
 #include "cli.hpp"
 #include "skelgraph/calib/board.hpp"
 #include "skelgraph/calib/calib_file.hpp"
+#include "skelgraph/calib/cell_calib.hpp"
 #include "skelgraph/calib/skeleton_calib.hpp"
 #include "skelgraph/eval/metrics.hpp"
 #include "skelgraph/mcap/mcap.hpp"
 #include "skelgraph/msg/cdr.hpp"
 #include "skelgraph/playback/readers.hpp"
 #include "skelgraph/runtime/topics.hpp"
+#include "skelgraph/sim/simulation.hpp"
 #include "skelgraph/skeleton/skeleton_msg.hpp"
 
 namespace skelgraph::cli {
@@ -31,7 +33,7 @@ namespace {
 struct SkelOptions {
   std::vector<std::string> inputs;
   std::string format;  // empty: MCAP recordings
-  std::string ref, other, out, ref_pose;
+  std::string ref, other, out, ref_pose, prior;
   double threshold_m = 0.12, clock_search_ms = 0, robust_scale_m = 0.05;
   bool holdout = false, json = false, best_rigid = false;
   int best_rigid_starts = 1;
@@ -100,6 +102,23 @@ Eigen::Isometry3d reference_in_world(const std::string& file, const std::string&
   throw UsageError(file + ": has no pose of the reference sensor '" + ref + "'");
 }
 
+// A calibration file's poses (world_from_sensor): --prior.
+std::map<std::string, Eigen::Isometry3d> prior_poses(const std::string& file) {
+  std::map<std::string, Eigen::Isometry3d> poses;
+  try {
+    for (const auto& p : calib::read_calib_file(file).sensors) poses[p.sensor_id] = p.pose;
+  } catch (const calib::CalibFileError& e) {
+    throw UsageError(e.what());
+  }
+  return poses;
+}
+
+// What a result says when the skeletons could not tell on which side of the person a sensor is.
+const char* const kUndecided =
+    "ambiguous: the person hardly moved about (turned on the spot?), so the skeletons cannot tell on which side of "
+    "them the sensor is, and nothing decided: kept the previous pose (the fit's guess, the side where both sensors "
+    "see the front more often, is in the JSON). Walk a loop facing where you go, or give the rough layout with --prior";
+
 void write_calib(const std::string& out, const calib::CalibFile& f) {
   try {
     calib::write_calib_file(out, f);
@@ -108,19 +127,155 @@ void write_calib(const std::string& out, const calib::CalibFile& f) {
   }
 }
 
+// The upper body as evaluation scores it, group by group (head, neck, torso, shoulders, elbows, hands).
+std::vector<skeleton::JointId> upper_body() {
+  std::vector<skeleton::JointId> upper;
+  for (int g = 0; g < static_cast<int>(eval::kGroupCount); ++g)
+    for (std::size_t k = 0; k < skeleton::kJointCount; ++k)
+      if (eval::group_of(skeleton::joint_at(k)) == g) upper.push_back(skeleton::joint_at(k));
+  return upper;
+}
+
+// An input's skeletons split in time at the middle of the reference's: the first half to fit, the second to check.
+std::pair<std::map<std::string, std::vector<calib::TimedSkeleton>>, std::map<std::string, std::vector<calib::TimedSkeleton>>>
+split_halves(const Input& in, const std::string& ref) {
+  const auto& r = in.by_sensor.at(ref);
+  std::int64_t lo = r.front().t_ns, hi = r.front().t_ns;
+  for (const auto& x : r) lo = std::min(lo, x.t_ns), hi = std::max(hi, x.t_ns);
+  const std::int64_t mid = lo + (hi - lo) / 2;
+  std::map<std::string, std::vector<calib::TimedSkeleton>> fit, test;
+  for (const auto& [id, v] : in.by_sensor)
+    for (const auto& x : v) (x.t_ns < mid ? fit[id] : test[id]).push_back(x);
+  return {fit, test};
+}
+
+// Median distance between one sensor's skeletons and every other sensor's
+// under the given poses (reference_from_sensor); NaN when none match.
+double cell_median(const std::map<std::string, std::vector<calib::TimedSkeleton>>& data, const std::string& s,
+                   const std::map<std::string, Eigen::Isometry3d>& poses, const std::vector<skeleton::JointId>& joints) {
+  std::vector<double> all;
+  if (!data.count(s) || !poses.count(s)) return std::nan("");
+  for (const auto& [t, v] : data) {
+    if (t == s || !poses.count(t)) continue;
+    const auto d = calib::joint_distances(data.at(s), v, poses.at(s).inverse() * poses.at(t), 0, joints, 2.0);
+    all.insert(all.end(), d.begin(), d.end());
+  }
+  return calib::median(all);
+}
+
+// Every sensor of one input at once (no --other and more than one other sensor).
+nlohmann::json calibrate_cell_input(const std::string& path, const SkelOptions& o, const Input& in,
+                                    std::vector<skeleton::SensorPose>* result) {
+  std::map<std::string, std::vector<calib::TimedSkeleton>> fit = in.by_sensor, test;
+  if (o.holdout) std::tie(fit, test) = split_halves(in, o.ref);
+  // The poses the input already implies (a shared frame when it has none).
+  std::map<std::string, Eigen::Isometry3d> before;
+  for (const auto& [id, v] : in.by_sensor) {
+    before[id] = in.poses.count(o.ref) && in.poses.count(id) ? Eigen::Isometry3d(in.poses.at(o.ref).inverse() * in.poses.at(id))
+                                                             : Eigen::Isometry3d::Identity();
+  }
+  calib::CellCalibOptions co;
+  co.pair.inlier_threshold_m = o.threshold_m;
+  co.pair.robust_scale_m = o.robust_scale_m;
+  co.prior = in.poses;
+  calib::CellCalibResult r;
+  try {
+    r = calib::calibrate_cell(fit, o.ref, co);
+  } catch (const calib::CalibError& e) {
+    throw UsageError(path + ": cannot calibrate the cell against " + o.ref + ": " + e.what());
+  }
+  std::map<std::string, Eigen::Isometry3d> after = before, chosen = before;
+  for (const auto& s : r.sensors)
+    if (s.placed) after[s.id] = s.reference_from_sensor;
+  const auto upper = upper_body();
+  nlohmann::json j{{"input", path}, {"reference", o.ref}, {"mode", "cell"}, {"joint_solution_rounds", r.rounds}};
+  auto& sensors = j["sensors"] = nlohmann::json::array();
+  std::size_t unplaced = 0, undecided = 0;
+  for (const auto& s : r.sensors) {
+    if (s.id == o.ref) continue;
+    nlohmann::json sj{{"sensor", s.id}, {"frames", in.by_sensor.at(s.id).size()}, {"placed", s.placed}};
+    if (!s.placed) {
+      ++unplaced;
+      sj["verdict"] = "not placed: it shares too few views with any placed sensor; kept the previous pose";
+      sj["improved"] = false;
+      sensors.push_back(sj);
+      continue;
+    }
+    // Never worse than before, sensor by sensor, on the data it was fitted to.
+    const double fb = cell_median(fit, s.id, before, {});
+    const double fa = cell_median(fit, s.id, after, {});
+    const bool improved = !s.ambiguous && !(fa >= fb);
+    if (improved) chosen[s.id] = after[s.id];
+    sj["path"] = s.path;
+    sj["reference_from_sensor"] = pose_json(s.reference_from_sensor);
+    sj["joint_pairs"] = s.pairs;
+    sj["median_distance_cm"] = num(cm(s.median_m));
+    sj["rms_residual_cm"] = num(cm(s.rms_m));
+    sj["max_residual_cm"] = num(cm(s.max_m));
+    sj["fit_median_distance_cm"] = {{"before", num(cm(fb))}, {"after", num(cm(fa))}};
+    sj["improved"] = improved;
+    sj["undecided"] = s.ambiguous;
+    if (s.ambiguous) ++undecided;
+    sj["verdict"] = s.ambiguous ? kUndecided
+                    : improved  ? "calibrated: brings its skeletons closer to the other sensors' than before"
+                                : "kept the previous pose: the fit did not bring its skeletons closer on the data it saw";
+    sensors.push_back(sj);
+  }
+  if (o.holdout) {
+    for (auto& sj : sensors) {
+      const auto id = sj["sensor"].get<std::string>();
+      sj["held_out_median_distance_cm"] = {{"before", num(cm(cell_median(test, id, before, upper)))},
+                                           {"after", num(cm(cell_median(test, id, chosen, upper)))}};
+    }
+  }
+  auto& links = j["links"] = nlohmann::json::array();
+  for (const auto& l : r.links) {
+    nlohmann::json lj{{"a", l.a}, {"b", l.b}, {"solved", l.solved}, {"in_tree", l.in_tree}, {"joint_pairs", l.pairs},
+                      {"mirrored_frames", l.mirrored}, {"median_distance_cm", num(cm(l.median_m))}};
+    if (l.solved) {
+      lj["ambiguous"] = l.fit.ambiguous;
+      lj["resolved_by_prior"] = l.fit.resolved_by_prior;
+      lj["person_spread_cm"] = cm(l.fit.person_spread_m);
+    }
+    if (!l.solved) lj["error"] = l.error;
+    links.push_back(lj);
+  }
+  j["unplaced"] = unplaced;
+  j["undecided"] = undecided;
+  if (result != nullptr) {
+    for (const auto& sj : sensors) {
+      skeleton::SensorPose p;
+      p.sensor_id = sj["sensor"].get<std::string>();
+      p.pose = chosen.at(p.sensor_id);
+      p.method = sj["improved"].get<bool>() ? "skeleton (cell)" : "unchanged";
+      if (sj["improved"].get<bool>()) {
+        // Its joint pairs' residuals under the joint solution.
+        const auto* s = r.sensor(p.sensor_id);
+        p.rms_residual_m = std::isfinite(s->rms_m) ? s->rms_m : 0.0;
+        p.max_residual_m = s->max_m;
+      }
+      result->push_back(p);
+    }
+  }
+  return j;
+}
+
 // One input: fit (on the first half with --holdout), check, and the verdict.
-nlohmann::json calibrate_one(const std::string& path, const SkelOptions& o, skeleton::SensorPose* result) {
-  const Input in = read_input(path, o.format);
+nlohmann::json calibrate_one(const std::string& path, const SkelOptions& o, std::vector<skeleton::SensorPose>* results) {
+  Input in = read_input(path, o.format);
+  if (o.prior == "shared") {
+    for (const auto& [id, v] : in.by_sensor) in.poses[id] = Eigen::Isometry3d::Identity();
+  } else if (!o.prior.empty()) {
+    in.poses = prior_poses(o.prior);
+  }
   std::string names;
   for (const auto& [id, v] : in.by_sensor) names += (names.empty() ? "" : ", ") + id + " (" + std::to_string(v.size()) + ")";
   if (!in.by_sensor.count(o.ref)) throw UsageError(path + ": no skeletons of reference sensor '" + o.ref + "'; sensors: " + names);
   std::string other = o.other;
   if (other.empty()) {
-    for (const auto& [id, v] : in.by_sensor) {
-      if (id == o.ref) continue;
-      if (!other.empty()) throw UsageError(path + ": several other sensors (" + names + "): pick one with --other");
-      other = id;
-    }
+    if (in.by_sensor.size() > 2) return calibrate_cell_input(path, o, in, results);
+    for (const auto& [id, v] : in.by_sensor)
+      if (id != o.ref) other = id;
     if (other.empty()) throw UsageError(path + ": only the reference sensor has skeletons (" + names + ")");
   } else if (!in.by_sensor.count(other)) {
     throw UsageError(path + ": no skeletons of sensor '" + other + "'; sensors: " + names);
@@ -133,17 +288,14 @@ nlohmann::json calibrate_one(const std::string& path, const SkelOptions& o, skel
 
   std::vector<calib::TimedSkeleton> fit_ref = ref, fit_oth = oth, test_ref, test_oth;
   if (o.holdout) {
-    std::int64_t lo = ref.front().t_ns, hi = ref.front().t_ns;
-    for (const auto& s : ref) lo = std::min(lo, s.t_ns), hi = std::max(hi, s.t_ns);
-    const std::int64_t mid = lo + (hi - lo) / 2;
-    fit_ref.clear(), fit_oth.clear();
-    for (const auto& s : ref) (s.t_ns < mid ? fit_ref : test_ref).push_back(s);
-    for (const auto& s : oth) (s.t_ns < mid ? fit_oth : test_oth).push_back(s);
+    auto [fit, test] = split_halves(in, o.ref);
+    fit_ref = fit[o.ref], fit_oth = fit[other], test_ref = test[o.ref], test_oth = test[other];
   }
   calib::SkeletonCalibOptions co;
   co.inlier_threshold_m = o.threshold_m;
   co.robust_scale_m = o.robust_scale_m;
   co.max_clock_offset_ns = static_cast<std::int64_t>(o.clock_search_ms * 1e6);
+  if (in.poses.count(o.ref) && in.poses.count(other)) co.prior = before;
   calib::SkeletonCalibResult r;
   try {
     r = calib::calibrate_from_skeletons(fit_ref, fit_oth, co);
@@ -153,7 +305,8 @@ nlohmann::json calibrate_one(const std::string& path, const SkelOptions& o, skel
   // Never worse than before: judged on the data it was fitted to (the held-out half stays unseen).
   const double fit_before = calib::median(calib::joint_distances(fit_ref, fit_oth, before, 0, {}, 2.0));
   const double fit_after = calib::median(calib::joint_distances(fit_ref, fit_oth, r.fit.transform(), r.clock_offset_ns, {}, 2.0));
-  const bool improved = !(fit_after >= fit_before);
+  const bool undecided = r.ambiguous && !r.resolved_by_prior;
+  const bool improved = !undecided && !(fit_after >= fit_before);
   const Eigen::Isometry3d chosen = improved ? r.fit.transform() : before;
   const std::int64_t chosen_offset = improved ? r.clock_offset_ns : 0;
 
@@ -164,7 +317,12 @@ nlohmann::json calibrate_one(const std::string& path, const SkelOptions& o, skel
                    {"reference_from_other", pose_json(r.fit.transform())},
                    {"clock_offset_ms", r.clock_offset_ns / 1e6},
                    {"matched_frames", r.matched},
-                   {"flipped_frames_rejected", r.flipped},
+                   {"mirrored_frames", r.mirrored},
+                   {"person_spread_cm", cm(r.person_spread_m)},
+                   {"turned_round_inliers", r.turned_inliers},
+                   {"ambiguous", r.ambiguous},
+                   {"resolved_by_prior", r.resolved_by_prior},
+                   {"undecided", undecided},
                    {"joint_pairs", r.pairs},
                    {"inliers", r.inliers},
                    {"rms_residual_cm", cm(r.fit.rms)},
@@ -176,11 +334,7 @@ nlohmann::json calibrate_one(const std::string& path, const SkelOptions& o, skel
   }
   j["per_joint"] = per;
   if (o.holdout) {
-    // The upper body as evaluation scores it, group by group (head, neck, torso, shoulders, elbows, hands).
-    std::vector<skeleton::JointId> upper;
-    for (int g = 0; g < static_cast<int>(eval::kGroupCount); ++g)
-      for (std::size_t k = 0; k < skeleton::kJointCount; ++k)
-        if (eval::group_of(skeleton::joint_at(k)) == g) upper.push_back(skeleton::joint_at(k));
+    const auto upper = upper_body();
     const double b = calib::median(calib::joint_distances(test_ref, test_oth, before, 0, upper, 2.0));
     const double a = calib::median(calib::joint_distances(test_ref, test_oth, chosen, chosen_offset, upper, 2.0));
     j["held_out_median_distance_cm"] = {{"before", num(cm(b))}, {"after", num(cm(a))}};
@@ -193,15 +347,18 @@ nlohmann::json calibrate_one(const std::string& path, const SkelOptions& o, skel
     auto& held_out = j["held_out_joints"] = nlohmann::json::array();
     for (auto jid : upper) held_out.push_back(skeleton::joint_name(jid));
   }
-  j["verdict"] = improved ? "calibrated: the fitted pose brings the sensors' skeletons closer than before"
-                          : "kept the previous pose: the fit did not bring the skeletons closer on the data it saw";
+  j["verdict"] = undecided ? kUndecided
+                : improved ? "calibrated: the fitted pose brings the sensors' skeletons closer than before"
+                           : "kept the previous pose: the fit did not bring the skeletons closer on the data it saw";
   j["improved"] = improved;
-  if (result != nullptr) {
-    result->sensor_id = other;
-    result->pose = chosen;
-    result->method = improved ? "skeleton" : "unchanged";
-    result->rms_residual_m = r.fit.rms;
-    result->max_residual_m = r.fit.max;
+  if (results != nullptr) {
+    skeleton::SensorPose p;
+    p.sensor_id = other;
+    p.pose = chosen;
+    p.method = improved ? "skeleton" : "unchanged";
+    p.rms_residual_m = r.fit.rms;
+    p.max_residual_m = r.fit.max;
+    results->push_back(p);
   }
   return j;
 }
@@ -212,10 +369,10 @@ int calib_skeleton(const SkelOptions& o) {
   nlohmann::json all = nlohmann::json::array();
   int failed = 0;
   for (const auto& path : o.inputs) {
-    skeleton::SensorPose pose;
+    std::vector<skeleton::SensorPose> poses;
     nlohmann::json j;
     try {
-      j = calibrate_one(path, o, &pose);
+      j = calibrate_one(path, o, &poses);
     } catch (const UsageError& e) {
       // One bad input does not stop the others; the exit code says something failed.
       if (o.inputs.size() == 1) throw;
@@ -224,6 +381,9 @@ int calib_skeleton(const SkelOptions& o) {
       ++failed;
       continue;
     }
+    const bool cell = j.value("mode", "") == "cell";
+    if (cell ? j["unplaced"].get<std::size_t>() + j["undecided"].get<std::size_t>() > 0 : j["undecided"].get<bool>())
+      ++failed;
     if (!o.out.empty()) {
       // world = the reference sensor's frame, unless --ref-pose places the reference in a world.
       const Eigen::Isometry3d world_from_ref = reference_in_world(o.ref_pose, o.ref);
@@ -233,20 +393,52 @@ int calib_skeleton(const SkelOptions& o) {
       ref.sensor_id = o.ref;
       ref.pose = world_from_ref;
       ref.method = o.ref_pose.empty() ? "reference" : "from " + o.ref_pose;
-      pose.pose = world_from_ref * pose.pose;
-      f.sensors = {ref, pose};
+      f.sensors = {ref};
+      for (auto p : poses) {
+        p.pose = world_from_ref * p.pose;
+        f.sensors.push_back(p);
+      }
       write_calib(o.out, f);
       j["written"] = o.out;
     }
-    if (!o.json) {
+    if (!o.json && cell) {
+      std::printf("%s: the whole cell against %s (%d joint solution rounds)\n", path.c_str(), o.ref.c_str(),
+                  j["joint_solution_rounds"].get<int>());
+      for (const auto& sj : j["sensors"]) {
+        std::printf("  %s: ", sj["sensor"].get<std::string>().c_str());
+        if (sj["placed"].get<bool>()) {
+          const auto& p = sj["reference_from_sensor"];
+          std::string via;
+          for (const auto& h : sj["path"]) via += (via.empty() ? "" : " > ") + h.get<std::string>();
+          std::printf("rotation %.2f deg, translation [%.3f, %.3f, %.3f] m, via %s; median distance to the others, "
+                      "fitted data %s -> %s cm",
+                      p["rotation_deg"].get<double>(), p["translation_m"][0].get<double>(), p["translation_m"][1].get<double>(),
+                      p["translation_m"][2].get<double>(), via.c_str(), sj["fit_median_distance_cm"]["before"].dump().c_str(),
+                      sj["fit_median_distance_cm"]["after"].dump().c_str());
+          if (o.holdout)
+            std::printf(", held-out %s -> %s cm", sj["held_out_median_distance_cm"]["before"].dump().c_str(),
+                        sj["held_out_median_distance_cm"]["after"].dump().c_str());
+          std::printf("\n    %s\n", sj["verdict"].get<std::string>().c_str());
+        } else {
+          std::printf("%s\n", sj["verdict"].get<std::string>().c_str());
+        }
+      }
+      std::printf("  pairs (median distance under the joint solution, frames seen from the back):");
+      for (const auto& l : j["links"]) {
+        if (l["joint_pairs"].get<std::size_t>() == 0) continue;
+        std::printf(" %s-%s %s cm (%zu mirrored);", l["a"].get<std::string>().c_str(), l["b"].get<std::string>().c_str(),
+                    l["median_distance_cm"].dump().c_str(), l["mirrored_frames"].get<std::size_t>());
+      }
+      std::printf("%s\n", o.out.empty() ? "" : ("\n  written to " + o.out).c_str());
+    } else if (!o.json) {
       std::printf("%s: %s from %s\n", path.c_str(), j["other"].get<std::string>().c_str(), o.ref.c_str());
       const auto& p = j["reference_from_other"];
       std::printf("  pose: rotation %.2f deg, translation [%.3f, %.3f, %.3f] m, clock offset %.1f ms\n",
                   p["rotation_deg"].get<double>(), p["translation_m"][0].get<double>(), p["translation_m"][1].get<double>(),
                   p["translation_m"][2].get<double>(), j["clock_offset_ms"].get<double>());
-      std::printf("  %zu frames matched, %zu rejected as left/right flipped; %zu of %zu joint pairs within %.0f cm, "
+      std::printf("  %zu frames matched, %zu of them seen from the back (sides swapped); %zu of %zu joint pairs within %.0f cm, "
                   "RMS %.1f cm, max %.1f cm\n",
-                  j["matched_frames"].get<std::size_t>(), j["flipped_frames_rejected"].get<std::size_t>(),
+                  j["matched_frames"].get<std::size_t>(), j["mirrored_frames"].get<std::size_t>(),
                   j["inliers"].get<std::size_t>(), j["joint_pairs"].get<std::size_t>(), o.threshold_m * 100,
                   j["rms_residual_cm"].get<double>(), j["max_residual_cm"].get<double>());
       std::printf("  per joint (median / RMS cm):");
@@ -269,6 +461,156 @@ int calib_skeleton(const SkelOptions& o) {
   }
   if (o.json) std::printf("%s\n", all.dump(2).c_str());
   return failed > 0 ? 1 : 0;
+}
+
+// --- The simulated cell: calibrated from its skeletons, against its truth ---
+
+struct SimCalibOptions {
+  std::vector<std::string> layouts{"ring:3", "ring:4", "ring:6", "corners:4"};
+  std::vector<std::string> scenarios{"walk", "360"};
+  std::vector<int> seeds{1, 2, 3};
+  double seconds = 60;
+  std::vector<std::string> params;
+  double target_deg = 1.0, target_cm = 2.0;
+  bool json = false, floor = false;
+};
+
+// How far an estimated pose is from the true one: rotation (degrees), translation (cm).
+std::pair<double, double> pose_error(const Eigen::Isometry3d& est, const Eigen::Isometry3d& truth) {
+  return {calib::rotation_angle_deg(est.linear() * truth.linear().transpose()),
+          100.0 * (est.translation() - truth.translation()).norm()};
+}
+
+nlohmann::json calib_sim_run(const SimCalibOptions& o, const std::string& layout, const std::string& scenario, int seed) {
+  const auto colon = layout.find(':');
+  if (colon == std::string::npos) throw UsageError("--layouts: '" + layout + "' is not LAYOUT:SENSORS, e.g. ring:3");
+  const std::string name = layout.substr(0, colon), count = layout.substr(colon + 1);
+  const sim::SimConfig cfg = sim_config(o.params, "calib sim",
+                                        {{"layout", name, "--layouts"},
+                                         {"sensor_count", count, "--layouts"},
+                                         {"scenario", scenario, "--scenarios"},
+                                         {"seed", std::to_string(seed), "--seeds"},
+                                         {"repeats", "1000", "calib sim"}});
+  sim::Simulation simulation(cfg);
+  std::map<std::string, std::vector<calib::TimedSkeleton>> by_sensor;
+  for (auto& e : simulation.advance(o.seconds)) {
+    if (e.kind != sim::SimEvent::Kind::Raw) continue;
+    by_sensor[cfg.sensors[e.sensor].id].push_back({static_cast<std::int64_t>(std::llround(e.t * 1e9)), std::move(e.skeleton)});
+  }
+  const std::string ref = cfg.sensors.front().id;
+  const Eigen::Isometry3d world_from_ref = cfg.sensors.front().world_from_sensor();
+  nlohmann::json run{{"layout", name}, {"sensor_count", cfg.sensors.size()}, {"scenario", scenario}, {"seed", seed},
+                     {"seconds", o.seconds}, {"reference", ref}};
+  calib::CellCalibResult r;
+  try {
+    r = calib::calibrate_cell(by_sensor, ref);
+  } catch (const calib::CalibError& e) {
+    run["error"] = e.what();
+    run["within_target"] = false;
+    return run;
+  }
+  double worst_deg = 0, worst_cm = 0;
+  bool all_placed = true;
+  auto& sensors = run["sensors"] = nlohmann::json::array();
+  for (const auto& c : cfg.sensors) {
+    if (c.id == ref) continue;
+    const Eigen::Isometry3d truth = world_from_ref.inverse() * c.world_from_sensor();
+    const auto* s = r.sensor(c.id);
+    nlohmann::json j{{"sensor", c.id}, {"frames", by_sensor.count(c.id) ? by_sensor.at(c.id).size() : 0}};
+    if (s == nullptr || !s->placed) {
+      j["placed"] = false;
+      all_placed = false;
+      sensors.push_back(j);
+      continue;
+    }
+    const auto [deg, cm_off] = pose_error(s->reference_from_sensor, truth);
+    worst_deg = std::max(worst_deg, deg);
+    worst_cm = std::max(worst_cm, cm_off);
+    j["placed"] = true;
+    j["path"] = s->path;
+    j["ambiguous"] = s->ambiguous;
+    j["rotation_error_deg"] = deg;
+    j["translation_error_cm"] = cm_off;
+    j["median_distance_cm"] = num(cm(s->median_m));
+    // The same sensor calibrated directly against the reference alone (the pair method), for comparison.
+    for (const auto& l : r.links) {
+      if (l.a != ref || l.b != c.id) continue;
+      if (l.solved) {
+        const auto [d2, c2] = pose_error(l.fit.fit.transform(), truth);
+        j["pair_alone"] = {{"rotation_error_deg", d2}, {"translation_error_cm", c2}, {"mirrored_frames", l.fit.mirrored},
+                           {"matched_frames", l.fit.matched}, {"ambiguous", l.fit.ambiguous},
+                           {"inliers", l.fit.inliers}, {"turned_inliers", l.fit.turned_inliers}};
+      } else {
+        j["pair_alone"] = {{"error", l.error}};
+      }
+    }
+    if (o.floor && by_sensor.count(c.id)) {
+      // The floor: the rigid pose the skeletons themselves favour, searched from the truth (lowest median joint
+      // distance to the reference's skeletons); how far it is from the truth, no calibration from them can undo.
+      const auto low = calib::lowest_median_pose(by_sensor.at(ref), by_sensor.at(c.id), truth, 0, {}, 2.0);
+      const auto [fd, fc] = pose_error(low.reference_from_other, truth);
+      j["floor"] = {{"rotation_error_deg", fd}, {"translation_error_cm", fc}, {"median_cm", num(cm(low.median_m))},
+                    {"median_at_truth_cm", num(cm(low.start_median_m))}};
+    }
+    sensors.push_back(j);
+  }
+  run["max_rotation_error_deg"] = worst_deg;
+  run["max_translation_error_cm"] = worst_cm;
+  run["within_target"] = all_placed && worst_deg <= o.target_deg && worst_cm <= o.target_cm;
+  return run;
+}
+
+int calib_sim(const SimCalibOptions& o) {
+  nlohmann::json runs = nlohmann::json::array();
+  const std::size_t total = o.layouts.size() * o.scenarios.size() * o.seeds.size();
+  Progress progress;  // on stderr, with --json too: a run takes seconds
+  std::size_t within = 0;
+  double worst_deg = 0, worst_cm = 0;
+  if (!o.json) {
+    std::printf("Every sensor calibrated from %.0f s of skeletons, the whole cell at once, against the simulator's truth "
+                "(target: within %.1f deg and %.1f cm)\n",
+                o.seconds, o.target_deg, o.target_cm);
+  }
+  for (const auto& layout : o.layouts) {
+    for (const auto& scenario : o.scenarios) {
+      for (const int seed : o.seeds) {
+        progress("calibrating " + layout + " " + scenario + " seed " + std::to_string(seed) + " (" +
+                 std::to_string(runs.size() + 1) + " of " + std::to_string(total) + ")");
+        auto run = calib_sim_run(o, layout, scenario, seed);
+        progress.done(false);
+        within += run["within_target"].get<bool>() ? 1 : 0;
+        if (run.contains("max_rotation_error_deg")) {
+          worst_deg = std::max(worst_deg, run["max_rotation_error_deg"].get<double>());
+          worst_cm = std::max(worst_cm, run["max_translation_error_cm"].get<double>());
+        }
+        if (!o.json) {
+          std::printf("%-10s %-5s seed %d: ", layout.c_str(), scenario.c_str(), seed);
+          if (run.contains("error")) {
+            std::printf("FAILED: %s\n", run["error"].get<std::string>().c_str());
+          } else {
+            for (const auto& s : run["sensors"]) {
+              if (!s["placed"].get<bool>()) std::printf(" %s not placed;", s["sensor"].get<std::string>().c_str());
+              else std::printf(" %s %.2f deg %.1f cm%s;", s["sensor"].get<std::string>().c_str(),
+                               s["rotation_error_deg"].get<double>(), s["translation_error_cm"].get<double>(),
+                               s["ambiguous"].get<bool>() ? " (ambiguous)" : "");
+            }
+            std::printf(" %s\n", run["within_target"].get<bool>() ? "ok" : "OUTSIDE");
+          }
+        }
+        runs.push_back(std::move(run));
+      }
+    }
+  }
+  const nlohmann::json summary{{"runs", runs.size()}, {"within_target", within}, {"target_deg", o.target_deg},
+                               {"target_cm", o.target_cm}, {"max_rotation_error_deg", worst_deg},
+                               {"max_translation_error_cm", worst_cm}};
+  if (o.json) {
+    std::printf("%s\n", nlohmann::json{{"summary", summary}, {"runs", runs}}.dump(2).c_str());
+  } else {
+    std::printf("%zu of %zu runs with every sensor within target; worst %.2f deg, %.1f cm\n", within, runs.size(), worst_deg,
+                worst_cm);
+  }
+  return within == runs.size() ? 0 : 1;
 }
 
 // --- Checkerboards ---
@@ -539,15 +881,23 @@ void add_calib_command(CLI::App& app, GlobalOptions&, Action& run) {
   auto o = std::make_shared<SkelOptions>();
   auto* s = cal->add_subcommand(
       "skeleton",
-      "Extrinsics from the person's own skeleton: two sensors' skeletons of the same people at the same time "
-      "(walk around in front of both for 30 s); flipped frames and other people are rejected");
+      "Extrinsics from the person's own skeleton: sensors' skeletons of the same people at the same time (walk "
+      "around in front of them for 30 s or more); views of the back are used with their sides swapped, other people "
+      "rejected. Without --other and with more than one other sensor: every sensor of the cell at once, one file");
   s->add_option("inputs", o->inputs, "MCAP recordings (skelgraph/skeleton/raw), or data-set files with --format")
       ->required()
       ->check(CLI::ExistingFile);
   s->add_option("--format", o->format, "the inputs are data-set files of this format")
       ->check(CLI::IsMember(playback::format_names()));
   s->add_option("--ref", o->ref, "reference sensor id (its frame is the result's frame)")->required();
-  s->add_option("--other", o->other, "the sensor to calibrate (default: the only other one)");
+  s->add_option("--other", o->other, "the one sensor to calibrate against the reference (default: the only other one, or "
+                                     "with several: all of them, jointly)");
+  s->add_option("--prior", o->prior,
+                "a calibration file with the sensors' rough poses (a previous calibration, a measured layout), or "
+                "'shared' when the input's skeletons already share a rough frame (data sets mapped by their recording "
+                "app): the previous poses (instead of the recording's), and what decides when the skeletons cannot "
+                "tell on which side of the person a sensor is")
+      ->check(CLI::ExistingFile | CLI::IsMember({"shared"}));
   s->add_option("--threshold-m", o->threshold_m, "a joint pair agrees within this under a good pose")->check(kPositive);
   s->add_option("--robust-scale-m", o->robust_scale_m, "scale of the Cauchy weights in the refits, 1 / (1 + (r / this)^2) (default 0.05; 0: plain least squares)")
       ->check(CLI::NonNegativeNumber);
@@ -569,6 +919,25 @@ void add_calib_command(CLI::App& app, GlobalOptions&, Action& run) {
       ->check(CLI::ExistingFile);
   s->add_flag("--json", o->json, "machine-readable results, one object per input");
   s->callback([o, &run] { run = [o] { return calib_skeleton(*o); }; });
+
+  auto so = std::make_shared<SimCalibOptions>();
+  auto* sc = cal->add_subcommand("sim",
+                                 "Calibrate the simulated cell from its skeletons (every sensor, the whole cell at once) and "
+                                 "compare each pose with the simulator's truth; exit 1 when a run misses the target");
+  sc->add_option("--layouts", so->layouts, "LAYOUT:SENSORS list (layouts: quarters, ring, one_side, corners; default "
+                                           "ring:3,ring:4,ring:6,corners:4)")
+      ->delimiter(',');
+  sc->add_option("--scenarios", so->scenarios, "simulator scenarios (default walk,360)")->delimiter(',');
+  sc->add_option("--seeds", so->seeds, "seeds (default 1,2,3)")->delimiter(',');
+  sc->add_option("--seconds", so->seconds, "seconds of skeletons per run (default 60)")->check(kPositive);
+  sc->add_option("-p,--param", so->params, "further sim parameter KEY=VALUE (repeatable; e.g. people=2)");
+  sc->add_option("--target-deg", so->target_deg, "a sensor within this rotation error (default 1)")->check(kPositive);
+  sc->add_option("--target-cm", so->target_cm, "... and this translation error (default 2)")->check(kPositive);
+  sc->add_flag("--floor", so->floor,
+               "also search, from each sensor's true pose, the pose its skeletons and the reference's agree on best "
+               "(lowest median distance): how far the data themselves are from the truth (slower)");
+  sc->add_flag("--json", so->json, "machine-readable results: a summary and every run");
+  sc->callback([so, &run] { run = [so] { return calib_sim(*so); }; });
 
   auto b = std::make_shared<BoardOptions>();
   auto* in = cal->add_subcommand("intrinsics", "Camera intrinsics from images of a checkerboard (OpenCV calibrateCamera)");

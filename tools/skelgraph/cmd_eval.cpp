@@ -359,8 +359,6 @@ RecordingReport eval_recording_section(const std::string& file, const std::strin
 }
 
 int eval_sim(const SimEvalOptions& o) {
-  runtime::ParamSchema schema;
-  sim::add_sim_params(schema);
   eval::OfflineOptions eo = eval::offline_options(o.methods, o.delay_ms, o.max_age_ms);
   eo.trace = !o.report_dir.empty();
   std::string html;
@@ -375,18 +373,7 @@ int eval_sim(const SimEvalOptions& o) {
                 o.delay_ms, o.max_age_ms);
   }
   for (const auto& scenario : o.scenarios) {
-    sim::SimConfig cfg;
-    try {
-      std::vector<runtime::RawParam> raw;
-      for (const auto& p : o.params) raw.push_back(runtime::parse_param_assignment(p, "--param " + p));
-      raw.push_back({"scenario", scenario, "--scenarios"});
-      cfg = sim::sim_config_from(schema.resolve(raw, "eval sim"));
-      sim::Simulation probe(cfg);
-    } catch (const runtime::ParamError& e) {
-      throw UsageError(e.what());
-    } catch (const std::invalid_argument& e) {
-      throw UsageError(e.what());
-    }
+    const sim::SimConfig cfg = sim_config(o.params, "eval sim", {{"scenario", scenario, "--scenarios"}});
     std::map<std::string, Eigen::Isometry3d> poses;
     for (const auto& s : cfg.sensors) poses[s.id] = s.world_from_sensor();
     std::vector<eval::TimedSkeleton> events;

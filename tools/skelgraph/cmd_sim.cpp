@@ -23,6 +23,24 @@
 
 namespace skelgraph::cli {
 
+sim::SimConfig sim_config(const std::vector<std::string>& assignments, const char* what,
+                          const std::vector<runtime::RawParam>& extra) {
+  runtime::ParamSchema schema;
+  sim::add_sim_params(schema);
+  try {
+    std::vector<runtime::RawParam> raw;
+    for (const auto& p : assignments) raw.push_back(runtime::parse_param_assignment(p, "--param " + p));
+    raw.insert(raw.end(), extra.begin(), extra.end());
+    auto cfg = sim::sim_config_from(schema.resolve(raw, what));
+    sim::Simulation probe(cfg);  // checks the configuration
+    return cfg;
+  } catch (const runtime::ParamError& e) {
+    throw UsageError(e.what());
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+}
+
 namespace {
 
 int table(const sim::RealismOptions& opt, bool json, bool check) {
@@ -87,27 +105,9 @@ void write_file(const std::filesystem::path& path, const playback::Recording& re
   if (!out.flush()) throw std::runtime_error("error writing " + path.string());
 }
 
-// Runs the simulation offline and writes truth.csv, raw_<sensor>.csv and phases.csv.
-// The simulator's configuration from -p KEY=VALUE, checked (UsageError).
-sim::SimConfig config_from(const std::vector<std::string>& assignments, const char* what) {
-  runtime::ParamSchema schema;
-  sim::add_sim_params(schema);
-  try {
-    std::vector<runtime::RawParam> raw;
-    for (const auto& p : assignments) raw.push_back(runtime::parse_param_assignment(p, "--param " + p));
-    auto cfg = sim::sim_config_from(schema.resolve(raw, what));
-    sim::Simulation probe(cfg);  // checks the configuration
-    return cfg;
-  } catch (const runtime::ParamError& e) {
-    throw UsageError(e.what());
-  } catch (const std::invalid_argument& e) {
-    throw UsageError(e.what());
-  }
-}
-
 // The simulated sensors' true poses as a calibration file.
 int write_poses(const std::vector<std::string>& assignments, const std::string& out, bool json) {
-  const auto cfg = config_from(assignments, "sim poses");
+  const auto cfg = sim_config(assignments, "sim poses");
   calib::CalibFile f;
   f.comment = "the simulator's true sensor poses (skelgraph sim poses)";
   for (const auto& s : cfg.sensors) {
@@ -143,7 +143,7 @@ struct BoardsOpts {
 };
 
 int write_boards(const BoardsOpts& o) {
-  const auto cfg = config_from(o.params, "sim boards");
+  const auto cfg = sim_config(o.params, "sim boards");
   calib::Board board;
   try {
     board = calib::Board::parse(o.size, o.square_m);
@@ -218,7 +218,7 @@ int write_boards(const BoardsOpts& o) {
 }
 
 int export_run(const std::vector<std::string>& assignments, const std::string& dir, bool json) {
-  const auto cfg = config_from(assignments, "sim export");
+  const auto cfg = sim_config(assignments, "sim export");
   sim::Simulation sim(cfg);
   std::map<std::string, std::string> meta{{"source", "skelgraph sim"},
                                           {"scenario", cfg.scenario.name},

@@ -95,11 +95,40 @@ struct Fit {
   bool swapped = false;
 };
 
+// Which labelling of the other's skeleton the two sensors' places allow
+// under `pose`. A tracker takes the person to face it (a view of the back
+// claims the reverse facing), so each skeleton's claimed facing points
+// towards its own sensor: the two agree as labelled when the other sensor is
+// on that side of the chest too, and with the sides swapped when it is behind.
+// Told by each skeleton on its own; 0: as labelled, 1: swapped, -1: either
+// (a sensor near the chest's plane, or no shoulders), -2: the two disagree.
+int expected_swap(const Skeleton& ref, const Skeleton& other, const Alignment& pose) {
+  constexpr double kMargin = 0.7;  // |cos| of the angle to the chest's normal: 45 degrees or less from it
+  const auto side = [](const Skeleton& s, const Vector3d& sensor) {
+    const auto torso = s[JointId::Torso];
+    const auto neck = s[JointId::Neck];
+    if (torso.confidence <= 0 || neck.confidence <= 0) return -1;
+    const auto f = skeleton::claimed_facing(s, neck.position - torso.position);
+    const Vector3d d = sensor - torso.position;
+    if (!f || d.norm() < 1e-6) return -1;
+    const double c = f->dot(d) / d.norm();
+    return c > kMargin ? 0 : c < -kMargin ? 1 : -1;
+  };
+  const int a = side(ref, pose.t);                                // the other sensor's origin, in the reference's frame
+  const int b = side(other, Vector3d(-pose.R.transpose() * pose.t));  // the reference's origin, in the other's frame
+  if (a < 0) return b;
+  if (b < 0) return a;
+  return a == b ? a : -2;
+}
+
 Fit fit_of(const Candidate& c, const Alignment& pose, const std::vector<JointId>& joints, double thr) {
   Fit best;
   std::vector<double> d;
   for (std::size_t o = 0; o < c.others.size(); ++o) {
+    const int expected = expected_swap(*c.ref, c.others[o], pose);
+    if (expected == -2) continue;
     for (const bool swapped : {false, true}) {
+      if (expected >= 0 && swapped != (expected == 1)) continue;
       d.clear();
       std::size_t agree = 0;
       for (const auto j : joints) {
@@ -120,25 +149,29 @@ Fit fit_of(const Candidate& c, const Alignment& pose, const std::vector<JointId>
 struct Pairs {
   std::vector<Vector3d> other, ref;
   std::vector<JointId> joint;
-  std::size_t matched = 0, flipped = 0;
+  std::vector<bool> swapped;
+  std::size_t matched = 0, mirrored = 0;
 };
 
+// A match fitting better with the other's sides swapped: one of the two
+// sensors sees the person's back and, assuming they face it, labelled their
+// left as right. The joints are where they are; only the labels are swapped,
+// so the pairs are made with the sides swapped back.
 Pairs pair_up(const std::vector<Candidate>& cs, const Alignment& pose, const std::vector<JointId>& joints,
               const SkeletonCalibOptions& o) {
   Pairs p;
   for (const auto& c : cs) {
     const Fit f = fit_of(c, pose, joints, o.inlier_threshold_m);
     if (!(f.median_m <= o.match_median_m)) continue;
-    if (f.swapped) {
-      ++p.flipped;  // one of the two sees the person's back and swapped left and right
-      continue;
-    }
     ++p.matched;
+    p.mirrored += f.swapped ? 1 : 0;
     for (const auto j : joints) {
-      if (!tracked(*c.ref, j) || !tracked(c.others[f.other], j)) continue;
-      p.other.push_back(c.others[f.other][j].position);
+      const JointId oj = f.swapped ? skeleton::mirror(j) : j;
+      if (!tracked(*c.ref, j) || !tracked(c.others[f.other], oj)) continue;
+      p.other.push_back(c.others[f.other][oj].position);
       p.ref.push_back((*c.ref)[j].position);
       p.joint.push_back(j);
+      p.swapped.push_back(f.swapped);
     }
   }
   return p;
@@ -157,29 +190,33 @@ Alignment propose(const std::vector<Candidate>& cs, const std::vector<JointId>& 
   for (int h = 0; h < o.hypotheses; ++h) {
     const Candidate& c = cs[pick(rng)];
     const Skeleton& other = c.others[std::uniform_int_distribution<std::size_t>(0, c.others.size() - 1)(rng)];
-    std::vector<Vector3d> a, b;
-    for (const auto j : joints) {
-      if (tracked(*c.ref, j) && tracked(other, j)) a.push_back(other[j].position), b.push_back((*c.ref)[j].position);
-    }
-    if (a.size() < 4) continue;
-    Alignment pose;
-    try {
-      pose = align(a, b);
-    } catch (const CalibError&) {
-      continue;
-    }
-    std::size_t score = 0;
-    std::vector<double> meds;
-    for (const auto* s : scored) {
-      const Fit f = fit_of(*s, pose, joints, o.inlier_threshold_m);
-      score += f.agree;
-      if (std::isfinite(f.median_m)) meds.push_back(f.median_m);
-    }
-    const double med = median(meds);
-    if (score > best_score || (score == best_score && med < best_med)) {
-      best = pose;
-      best_score = score;
-      best_med = med;
+    // The frame as labelled, and with the other's sides swapped (a view of the back).
+    for (const bool swapped : {false, true}) {
+      std::vector<Vector3d> a, b;
+      for (const auto j : joints) {
+        const JointId oj = swapped ? skeleton::mirror(j) : j;
+        if (tracked(*c.ref, j) && tracked(other, oj)) a.push_back(other[oj].position), b.push_back((*c.ref)[j].position);
+      }
+      if (a.size() < 4) continue;
+      Alignment pose;
+      try {
+        pose = align(a, b);
+      } catch (const CalibError&) {
+        continue;
+      }
+      std::size_t score = 0;
+      std::vector<double> meds;
+      for (const auto* s : scored) {
+        const Fit f = fit_of(*s, pose, joints, o.inlier_threshold_m);
+        score += f.agree;
+        if (std::isfinite(f.median_m)) meds.push_back(f.median_m);
+      }
+      const double med = median(meds);
+      if (score > best_score || (score == best_score && med < best_med)) {
+        best = pose;
+        best_score = score;
+        best_med = med;
+      }
     }
   }
   if (best_score == 0) throw CalibError("no frame gave a pose that any other frame agrees with");
@@ -209,7 +246,7 @@ SkeletonCalibResult solve(const std::vector<Candidate>& cs, Alignment pose, cons
     if (a.size() < 10) {
       throw CalibError("only " + std::to_string(a.size()) + " joint pairs agree with the best pose within " +
                        std::to_string(o.inlier_threshold_m) + " m (" + std::to_string(p.matched) + " frames matched, " +
-                       std::to_string(p.flipped) + " flipped)");
+                       std::to_string(p.mirrored) + " of them mirrored)");
     }
     // Robust weights (Cauchy, scale c): a joint the tracker placed far off
     // (hidden behind the body, still claimed) pulls less than a clean one.
@@ -225,7 +262,7 @@ SkeletonCalibResult solve(const std::vector<Candidate>& cs, Alignment pose, cons
     r.fit = fit;
     r.reference_frames = cs.size();
     r.matched = p.matched;
-    r.flipped = p.flipped;
+    r.mirrored = p.mirrored;
     r.pairs = p.ref.size();
     r.inliers = a.size();
     std::map<JointId, std::vector<double>> per;
@@ -242,6 +279,53 @@ SkeletonCalibResult solve(const std::vector<Candidate>& cs, Alignment pose, cons
     if (moved < 1e-5) break;  // 0.01 mm (or 0.001 degree)
   }
   return r;
+}
+
+// Below this the person did not move about enough to tell a sensor's side (m, RMS).
+constexpr double kMinSpreadM = 0.15;
+
+// Where the person was (the reference's torsos) and which way is up (its
+// spine), and how far the person moved about: the RMS distance of the torsos
+// from their mean across the up axis.
+struct Spread {
+  Vector3d centre = Vector3d::Zero(), up = Vector3d::UnitY();
+  double rms_m = 0;
+  bool valid = false;
+};
+
+Spread spread_of(const std::vector<Candidate>& cs) {
+  Spread sp;
+  std::vector<Vector3d> torsos;
+  Vector3d up = Vector3d::Zero();
+  for (const auto& k : cs) {
+    if (!tracked(*k.ref, JointId::Torso) || !tracked(*k.ref, JointId::Neck)) continue;
+    torsos.push_back((*k.ref)[JointId::Torso].position);
+    up += (*k.ref)[JointId::Neck].position - (*k.ref)[JointId::Torso].position;
+  }
+  if (torsos.empty() || up.norm() < 1e-9) return sp;
+  sp.up = up.normalized();
+  for (const auto& t : torsos) sp.centre += t;
+  sp.centre /= static_cast<double>(torsos.size());
+  double ss = 0;
+  for (const auto& t : torsos) {
+    const Vector3d d = t - sp.centre;
+    ss += (d - d.dot(sp.up) * sp.up).squaredNorm();
+  }
+  sp.rms_m = std::sqrt(ss / static_cast<double>(torsos.size()));
+  sp.valid = true;
+  return sp;
+}
+
+// The pose turned by 180 degrees about the vertical through where the
+// person was. For a person turning on the spot it explains the skeletons
+// about as well as the pose itself, with every match's sides swapped the
+// other way: a body turned round looks like its mirror image.
+Alignment turned_about(const Spread& sp, const Alignment& pose) {
+  const Eigen::Matrix3d Q = Eigen::AngleAxisd(M_PI, sp.up).toRotationMatrix();
+  Alignment a = pose;
+  a.R = Q * pose.R;
+  a.t = Q * (pose.t - sp.centre) + sp.centre;
+  return a;
 }
 
 double median_residual(const std::vector<Candidate>& cs, const Alignment& pose, const std::vector<JointId>& joints,
@@ -294,8 +378,59 @@ SkeletonCalibResult calibrate_from_skeletons(const std::vector<TimedSkeleton>& r
                      std::to_string(o.max_gap_ns / 1'000'000) + " ms (do their times overlap? try a clock offset search)");
   }
   auto r = solve(cs, propose(cs, joints, o), joints, o);
+  // The pose turned round about the person, solved too: the one more joint
+  // pairs agree with wins. The skeletons cannot tell the two apart when the
+  // person hardly moved about (turning on the spot: the rival then explains
+  // the torsos too) or when as many pairs agree with both; then the one with
+  // fewer views of the back is kept, as sensors watching a person mostly see
+  // their front, and the result says it is ambiguous.
+  const Spread sp = spread_of(cs);
+  r.person_spread_m = sp.rms_m;
+  if (sp.valid) {
+    try {
+      auto alt = solve(cs, turned_about(sp, r.fit), joints, o);
+      r.turned_inliers = alt.inliers;
+      alt.turned_inliers = r.inliers;
+      alt.person_spread_m = sp.rms_m;
+      const double lo = static_cast<double>(std::min(r.inliers, alt.inliers));
+      const double hi = static_cast<double>(std::max(r.inliers, alt.inliers));
+      const bool ambiguous = lo >= 0.95 * hi || sp.rms_m < kMinSpreadM;
+      bool take_alt = alt.inliers > r.inliers;
+      if (ambiguous && o.prior) {
+        const Eigen::Matrix3d prior_R = o.prior->linear();
+        take_alt = rotation_angle_deg(alt.fit.R * prior_R.transpose()) < rotation_angle_deg(r.fit.R * prior_R.transpose());
+      } else if (ambiguous) {
+        take_alt = alt.mirrored < r.mirrored;
+      }
+      if (take_alt) r = std::move(alt);
+      r.ambiguous = ambiguous;
+      r.resolved_by_prior = ambiguous && o.prior.has_value();
+    } catch (const CalibError&) {
+      // Nothing agrees with the turned pose: not a rival.
+      r.ambiguous = sp.rms_m < kMinSpreadM;
+    }
+  }
   r.clock_offset_ns = offset;
   return r;
+}
+
+Correspondences correspondences(const std::vector<TimedSkeleton>& reference, const std::vector<TimedSkeleton>& other,
+                                const Eigen::Isometry3d& reference_from_other, const SkeletonCalibOptions& o) {
+  const auto& joints = o.joints.empty() ? default_joints() : o.joints;
+  Alignment pose;
+  pose.R = reference_from_other.linear();
+  pose.t = reference_from_other.translation();
+  const Pairs p = pair_up(candidates(reference, tracks_of(other), 0, o.max_gap_ns), pose, joints, o);
+  Correspondences c;
+  c.matched = p.matched;
+  c.mirrored = p.mirrored;
+  for (std::size_t i = 0; i < p.ref.size(); ++i) {
+    if ((pose.apply(p.other[i]) - p.ref[i]).norm() > o.inlier_threshold_m) continue;
+    c.reference.push_back(p.ref[i]);
+    c.other.push_back(p.other[i]);
+    c.mirrored_pair.push_back(p.swapped[i]);
+  }
+  return c;
 }
 
 std::vector<double> joint_distances(const std::vector<TimedSkeleton>& reference, const std::vector<TimedSkeleton>& other,
@@ -307,13 +442,16 @@ std::vector<double> joint_distances(const std::vector<TimedSkeleton>& reference,
     double best = std::numeric_limits<double>::infinity();
     std::vector<double> best_d;
     for (const auto& o : c.others) {
-      std::vector<double> d;
-      for (const auto j : joints) {
-        if (tracked(*c.ref, j) && tracked(o, j)) d.push_back((reference_from_other * o[j].position - (*c.ref)[j].position).norm());
+      for (const bool swapped : {false, true}) {  // as labelled, or a view of the back with its sides swapped
+        std::vector<double> d;
+        for (const auto j : joints) {
+          const JointId oj = swapped ? skeleton::mirror(j) : j;
+          if (tracked(*c.ref, j) && tracked(o, oj)) d.push_back((reference_from_other * o[oj].position - (*c.ref)[j].position).norm());
+        }
+        if (d.empty()) continue;
+        const double m = median(d);
+        if (m < best) best = m, best_d = std::move(d);
       }
-      if (d.empty()) continue;
-      const double m = median(d);
-      if (m < best) best = m, best_d = std::move(d);
     }
     if (best <= max_match_m) out.insert(out.end(), best_d.begin(), best_d.end());
   }

@@ -101,16 +101,7 @@ struct Track {
 };
 
 // The way the torso faces, from the shoulders as this view labels them (horizontal, unit), if it has them.
-std::optional<Vector3d> claimed_heading(const skeleton::Skeleton& s) {
-  const auto& l = s[JointId::LeftShoulder];
-  const auto& r = s[JointId::RightShoulder];
-  if (l.confidence <= 0 || r.confidence <= 0) return std::nullopt;
-  // y up, right-handed: left = up x forward, so forward = left x up.
-  Vector3d f = (l.position - r.position).cross(Vector3d::UnitY());
-  f.y() = 0;
-  if (f.norm() < 1e-6) return std::nullopt;
-  return f.normalized();
-}
+std::optional<Vector3d> claimed_heading(const skeleton::Skeleton& s) { return skeleton::claimed_facing(s, Vector3d::UnitY()); }
 
 }  // namespace
 

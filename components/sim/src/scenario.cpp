@@ -244,6 +244,8 @@ void script_point(Builder& b, Rng& rng) {
 }
 
 constexpr double kWalkRadius = 0.5;
+// tour: a wider circle, facing where they go (a calibration walk: every sensor sees the front and the back).
+constexpr double kTourRadius = 0.8;
 
 // shift: where the places are, and the doors the people come through
 // (outside every default sensor's view: on the diagonals, beyond 3 m).
@@ -303,7 +305,7 @@ BodyPose interpolate(const BodyPose& a, const BodyPose& b, double u) {
 }
 
 const std::vector<std::string>& scenario_names() {
-  static const std::vector<std::string> names{"walk", "360", "hide", "box", "occ", "sit", "arms", "point", "shift"};
+  static const std::vector<std::string> names{"walk", "360", "hide", "box", "occ", "sit", "arms", "point", "shift", "tour"};
   return names;
 }
 
@@ -329,7 +331,7 @@ Scenario::Scenario(const ScenarioOptions& options) : opt_(options) {
   const double hip_height = BodyDimensions::from_height(opt_.height).hip_height;
   for (int r = 0; r < opt_.repeats; ++r) {
     const auto& n = opt_.name;
-    if (n == "walk") {
+    if (n == "walk" || n == "tour") {
       const double lap = b.vary(20.0);
       walk_period_ = walk_period_ == 0.0 ? lap : walk_period_;
       b.t += walk_period_;
@@ -487,6 +489,13 @@ Scene Scenario::at(double t) const {
     first.pose.floor_position = kWalkRadius * Eigen::Vector2d(std::sin(a), -std::cos(a));
     first.pose.heading = heading_towards(first.pose.floor_position, opt_.facing);
     gait(first.pose, 2 * kPi * 0.9 * t);
+  } else if (opt_.name == "tour") {
+    const double a = 2 * kPi * t / walk_period_;
+    first.pose.floor_position = kTourRadius * Eigen::Vector2d(std::sin(a), -std::cos(a));
+    first.pose.heading = heading_towards(first.pose.floor_position,
+                                         first.pose.floor_position + Eigen::Vector2d(std::cos(a), std::sin(a)));
+    gait(first.pose, 2 * kPi * 0.9 * t);
+    first.phase = "walk";
   }
   scene.actors.push_back(first);
   // Others walk a wide circle through the cell, facing where they go.

@@ -28,7 +28,10 @@ void add_sim_params(runtime::ParamSchema& schema) {
       .add_string_list("sensors", {}, "sensor poses 'id:x,y,z,yaw_deg[,pitch_deg]' (yaw 180 looks along -z)")
       .add_double("truth_rate", 30.0, "ground-truth rate, Hz", 1.0, 1000.0)
       .add_double("drop_probability", 0.01, "chance that a sensor frame is lost", 0.0, 0.9)
-      .add_double("jitter_ms", 2.0, "sd of sensor frame timing, ms", 0.0, 20.0);
+      .add_double("jitter_ms", 2.0, "sd of sensor frame timing, ms", 0.0, 20.0)
+      .add_string("bump", "",
+                  "a sensor knocked out of place during the run, SENSOR,AT_S,YAW_DEG,SHIFT_M (turned about the vertical, "
+                  "moved to its own left); the poses published stay the calibrated ones (default: none)");
 }
 
 calib::Intrinsics parse_depth_size(const std::string& size) {
@@ -61,6 +64,7 @@ SimConfig sim_config_from(const runtime::Params& params) {
     s.drop_probability = params.get<double>("drop_probability");
     s.jitter_s = params.get<double>("jitter_ms") * 1e-3;
   }
+  if (const auto bump = params.get<std::string>("bump"); !bump.empty()) c.bumps.push_back(parse_bump(bump));
   // The first person faces sensor 1.
   c.scenario.facing = Eigen::Vector2d(c.sensors.front().position.x(), c.sensors.front().position.z());
   return c;

@@ -14,6 +14,7 @@ struct Simulation::SensorState {
   std::uint64_t frame = 0;
   std::vector<std::unique_ptr<TrackerModel>> trackers;  // one per place (Actor::slot)
   std::vector<std::uint32_t> reported;                  // per tracker: the user it reported last frame (0 none)
+  bool bumped = false;                                  // SimConfig::bumps applied
 };
 
 Simulation::Simulation(SimConfig config)
@@ -40,6 +41,11 @@ Simulation::Simulation(SimConfig config)
     }
     st->reported.assign(st->trackers.size(), 0);
     sensors_.push_back(std::move(st));
+  }
+  for (const auto& b : cfg_.bumps) {
+    if (std::none_of(cfg_.sensors.begin(), cfg_.sensors.end(), [&](const SensorConfig& c) { return c.id == b.sensor; })) {
+      throw std::invalid_argument("bump: no sensor '" + b.sensor + "' in this cell");
+    }
   }
 }
 
@@ -98,8 +104,47 @@ void Simulation::emit_truth(double t, std::vector<SimEvent>& out) {
   }
 }
 
+SimConfig::Bump parse_bump(const std::string& spec) {
+  const auto bad = [&](const std::string& why) {
+    return std::invalid_argument("bump '" + spec + "': " + why + " (expected SENSOR,AT_S,YAW_DEG,SHIFT_M, e.g. sensor2,60,3,0)");
+  };
+  std::vector<std::string> parts;
+  std::size_t from = 0;
+  for (;;) {
+    const auto comma = spec.find(',', from);
+    parts.push_back(spec.substr(from, comma == std::string::npos ? std::string::npos : comma - from));
+    if (comma == std::string::npos) break;
+    from = comma + 1;
+  }
+  if (parts.size() != 4) throw bad(std::to_string(parts.size()) + " fields");
+  if (parts[0].empty()) throw bad("no sensor");
+  SimConfig::Bump b;
+  b.sensor = parts[0];
+  double* fields[] = {&b.at_s, &b.yaw_deg, &b.shift_m};
+  for (int k = 0; k < 3; ++k) {
+    std::size_t used = 0;
+    try {
+      *fields[k] = std::stod(parts[k + 1], &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != parts[k + 1].size() || !std::isfinite(*fields[k])) throw bad("'" + parts[k + 1] + "' is not a number");
+  }
+  if (b.at_s < 0) throw bad("the time is negative");
+  return b;
+}
+
 void Simulation::emit_raw(std::size_t i, double t, std::vector<SimEvent>& out) {
   auto& st = *sensors_[i];
+  for (const auto& b : cfg_.bumps) {
+    if (b.sensor != st.config.id || t < b.at_s || st.bumped) continue;
+    // Knocked: turned about the vertical through it, moved to its own left.
+    st.bumped = true;
+    SensorConfig moved = st.config;
+    moved.yaw += b.yaw_deg * M_PI / 180.0;
+    moved.position += b.shift_m * (st.config.world_from_sensor().linear() * Eigen::Vector3d::UnitX());
+    for (auto& tracker : st.trackers) tracker->move_sensor(moved);
+  }
   const Scene scene = scenario_.at(t);
   std::vector<skeleton::Skeleton> truths;
   for (const auto& a : scene.actors) truths.push_back(forward_kinematics(body_, a.pose));

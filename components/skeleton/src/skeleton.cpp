@@ -21,6 +21,16 @@ std::optional<JointId> joint_from_name(std::string_view name) {
   return std::nullopt;
 }
 
+std::optional<Eigen::Vector3d> claimed_facing(const Skeleton& s, const Eigen::Vector3d& up) {
+  const auto& l = s[JointId::LeftShoulder];
+  const auto& r = s[JointId::RightShoulder];
+  if (l.confidence <= 0 || r.confidence <= 0) return std::nullopt;
+  // Right-handed: left = up x forward, so forward = left x up.
+  const Eigen::Vector3d f = (l.position - r.position).cross(up);
+  if (!(f.norm() > 1e-6)) return std::nullopt;
+  return Eigen::Vector3d(f.normalized());
+}
+
 std::optional<Eigen::Vector3d> centre_of(const skeleton::Skeleton& s) {
   const auto& torso = s[JointId::Torso];
   if (torso.confidence > 0) return torso.position;

@@ -9,10 +9,11 @@
 //    is scored by how many joints of all frames it brings within the
 //    threshold, each reference person taking the other sensor's person (as
 //    seen, or left/right swapped) that fits best.
-// 3. Under the best pose every reference person gets its match; frames whose
-//    match fits better swapped (one sensor sees the back and flipped the
-//    sides) are rejected, as are matches that fit badly (a different person,
-//    a ghost). The joint pairs left within the threshold are solved by
+// 3. Under the best pose every reference person gets its match; a match that
+//    fits better swapped (one sensor sees the back and, assuming the person
+//    faces it, swapped the sides) is paired with its sides swapped back;
+//    matches that fit badly (a different person, a ghost) are rejected. The
+//    joint pairs left within the threshold are solved by
 //    weighted SVD (Cauchy weights on the residuals: a joint hidden behind the
 //    body but still claimed pulls less); pairing and solving repeat until the
 //    pose settles.
@@ -21,6 +22,7 @@
 // sensor's frame into the reference sensor's.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -45,6 +47,10 @@ struct SkeletonCalibOptions {
   int hypotheses = 300;                          // frame-level RANSAC samples
   std::size_t max_scored_frames = 1500;          // hypotheses are scored on at most this many frames (evenly spread)
   std::uint64_t seed = 1;
+  // reference_from_other roughly known (a previous calibration, a measured
+  // layout): decides between the pose and its rival turned round about the
+  // person when the skeletons cannot (the one nearer in rotation is kept).
+  std::optional<Eigen::Isometry3d> prior;
 };
 
 struct JointResidual {
@@ -58,9 +64,19 @@ struct SkeletonCalibResult {
   std::int64_t clock_offset_ns = 0;  // other's clock + offset = reference's clock
   std::size_t reference_frames = 0;  // reference skeletons (person-frames) considered
   std::size_t matched = 0;           // ... with a matching skeleton of the other sensor
-  std::size_t flipped = 0;           // ... rejected as left/right swapped
+  std::size_t mirrored = 0;          // ... of them with the sides swapped (one sensor sees the back)
   std::size_t pairs = 0, inliers = 0;  // joint pairs solved, within the threshold
   std::vector<JointResidual> per_joint;
+  // The rival pose, turned by 180 degrees about the person, solved too: its
+  // inlier pairs. Ambiguous when within 5 % of this pose's, or when the person
+  // hardly moved about (person_spread_m, the RMS distance of the reference's
+  // torsos from their mean, under 15 cm): a body turned round looks like its
+  // mirror image, so a person turning on the spot cannot tell on which side
+  // of them a sensor is; walking about can.
+  std::size_t turned_inliers = 0;
+  double person_spread_m = 0;
+  bool ambiguous = false;
+  bool resolved_by_prior = false;  // ambiguous, and the prior chose
 };
 
 // Throws CalibError when there is nothing to solve (no overlap in time, no
@@ -69,10 +85,22 @@ SkeletonCalibResult calibrate_from_skeletons(const std::vector<TimedSkeleton>& r
                                              const std::vector<TimedSkeleton>& other,
                                              const SkeletonCalibOptions& options = {});
 
+// The joint pairs two sensors' skeletons give under a pose (each reference
+// skeleton with its best-fitting match of the other sensor, as labelled or
+// with the sides swapped; pairs within the inlier threshold).
+struct Correspondences {
+  std::vector<Eigen::Vector3d> reference, other;
+  std::vector<bool> mirrored_pair;     // per pair: from a match with the sides swapped
+  std::size_t matched = 0, mirrored = 0;
+};
+Correspondences correspondences(const std::vector<TimedSkeleton>& reference, const std::vector<TimedSkeleton>& other,
+                                const Eigen::Isometry3d& reference_from_other, const SkeletonCalibOptions& options = {});
+
 // For checking a pose on data it was not fitted to: every reference
 // skeleton's nearest skeleton of the other sensor (under `reference_from_other`,
-// interpolated to the same time), and the distance of each of `joints` (both
-// at confidence 1) between them, m. Matches farther than `max_match_m`
+// interpolated to the same time; as labelled or with its sides swapped,
+// whichever is nearer: a view of the back), and the distance of each of
+// `joints` (both at confidence 1) between them, m. Matches farther than `max_match_m`
 // (median over joints) are other people and left out.
 std::vector<double> joint_distances(const std::vector<TimedSkeleton>& reference, const std::vector<TimedSkeleton>& other,
                                     const Eigen::Isometry3d& reference_from_other, std::int64_t clock_offset_ns = 0,

@@ -26,7 +26,20 @@ struct SimConfig {
   std::int64_t epoch_ns = 0;     // world clock at t = 0
   bool emit_frames = false;      // also a Frame event for every sensor frame (seen anyone or not)
   bool emit_departures = false;  // also Lost and Left events (when a tracker drops a user, a person leaves)
+  // A sensor knocked out of place during the run (someone bumps it): from
+  // world time at_s on it is turned by yaw_deg about the vertical through it
+  // and moved shift_m to its own left; the poses in `sensors` (and those the
+  // sim component publishes) stay as they were.
+  struct Bump {
+    std::string sensor;
+    double at_s = 0, yaw_deg = 0, shift_m = 0;
+  };
+  std::vector<Bump> bumps;
 };
+
+// "SENSOR,AT_S,YAW_DEG,SHIFT_M" (e.g. "sensor2,60,3,0"); throws
+// std::invalid_argument naming what is wrong.
+SimConfig::Bump parse_bump(const std::string& spec);
 
 struct SimEvent {
   // Lost: sensor's tracker no longer reports user skeleton.person_id (at this

@@ -86,6 +86,8 @@ class TrackerModel {
                                             const std::vector<skeleton::Skeleton>& truths);
 
   bool flipped() const { return flipped_; }
+  // The sensor now stands elsewhere (it was bumped): what follows is seen from there.
+  void move_sensor(const SensorConfig& sensor) { view_ = SensorView(sensor); }
 
  private:
   enum class State { Searching, Tracking, Ghost };

@@ -66,6 +66,13 @@ struct Skeleton {
 // reported with any confidence. Empty when nothing is.
 std::optional<Eigen::Vector3d> centre_of(const Skeleton& s);
 
+// The way the chest faces as this skeleton's labels say (unit): from the
+// shoulders, forward = (left - right) x up; `up` is the world's up, or the
+// skeleton's own spine in a sensor's frame. Empty without both shoulders.
+// A tracker takes the person to face it, so a view of the back claims the
+// reverse.
+std::optional<Eigen::Vector3d> claimed_facing(const Skeleton& s, const Eigen::Vector3d& up);
+
 // The joint on the other side of the body (left hand <-> right hand); itself for the spine.
 JointId mirror(JointId id);
 // Swaps every left joint with its right counterpart (a tracker that sees the back labels them the other way round).
