@@ -510,3 +510,51 @@ TEST(SimSensors, LayoutsPlaceEverySensorRoundTheCellLookingAtIt) {
   EXPECT_THROW(sim::layout_sensors("corners", 3), std::invalid_argument);
   EXPECT_THROW(sim::layout_sensors("star", 3), std::invalid_argument);
 }
+
+// A bumped sensor: before the bump its skeletons are those of an untouched
+// run, after it the same person is seen from the moved sensor (its torso
+// where the moved sensor's frame puts the truth, not the old one's).
+TEST(SimBump, ASensorKnockedOutOfPlaceSeesFromWhereItNowIs) {
+  sim::SimConfig plain;
+  plain.scenario.name = "walk";
+  plain.scenario.repeats = 2;
+  sim::SimConfig bumped = plain;
+  bumped.bumps.push_back(sim::parse_bump("sensor2,10,5,0.1"));
+  sim::Simulation a(plain), b(bumped);
+  const auto ea = a.advance(20), eb = b.advance(20);
+  ASSERT_EQ(ea.size(), eb.size());
+  sim::SensorConfig moved = plain.sensors[1];
+  moved.yaw += 5 * kPi / 180;
+  moved.position += 0.1 * (plain.sensors[1].world_from_sensor().linear() * Eigen::Vector3d::UnitX());
+  const sim::SensorView old_view(plain.sensors[1]), new_view(moved);
+  std::size_t before = 0, after = 0;
+  for (std::size_t i = 0; i < ea.size(); ++i) {
+    if (ea[i].kind != sim::SimEvent::Kind::Raw || ea[i].sensor != 1) continue;
+    const auto truth = a.truth_at(ea[i].t).front();
+    const Eigen::Vector3d got = eb[i].skeleton[JointId::Torso].position;
+    if (ea[i].t < 10) {
+      EXPECT_EQ(got, ea[i].skeleton[JointId::Torso].position);
+      ++before;
+    } else {
+      // Nearer where the moved sensor sees the truth than where the old one did.
+      EXPECT_LT((got - new_view.to_sensor(truth[JointId::Torso].position)).norm(),
+                (got - old_view.to_sensor(truth[JointId::Torso].position)).norm());
+      ++after;
+    }
+  }
+  EXPECT_GT(before, 200u);
+  EXPECT_GT(after, 200u);
+  // Bad bumps are clear errors.
+  for (const auto& [spec, why] : {std::pair{"sensor2,10,5", "3 fields"}, {"sensor2,x,5,0", "'x' is not a number"},
+                                  {",1,2,3", "no sensor"}, {"sensor2,-1,0,0", "negative"}}) {
+    try {
+      sim::parse_bump(spec);
+      ADD_FAILURE() << spec << " accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+    }
+  }
+  sim::SimConfig nosuch = plain;
+  nosuch.bumps.push_back(sim::parse_bump("sensor9,1,1,0"));
+  EXPECT_THROW(sim::Simulation{nosuch}, std::invalid_argument);
+}
