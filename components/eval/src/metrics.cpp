@@ -1,5 +1,7 @@
 #include "skelgraph/eval/metrics.hpp"
 
+#include <Eigen/Cholesky>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -195,6 +197,76 @@ double Steadiness::mean_bone_sd_cm() const {
   double sum = 0;
   for (const auto& [n, v] : sd) sum += v;
   return sum / static_cast<double>(sd.size());
+}
+
+namespace {
+constexpr std::size_t kKeptForSpearman = 200000;
+constexpr double kChi2Of3At95 = 7.8147;
+
+std::vector<double> ranks(std::vector<double> v) {
+  std::vector<std::size_t> order(v.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return v[a] < v[b]; });
+  std::vector<double> r(v.size());
+  for (std::size_t i = 0; i < order.size();) {
+    std::size_t k = i;
+    while (k + 1 < order.size() && v[order[k + 1]] == v[order[i]]) ++k;
+    const double mean_rank = 0.5 * static_cast<double>(i + k);
+    for (std::size_t q = i; q <= k; ++q) r[order[q]] = mean_rank;
+    i = k + 1;
+  }
+  return r;
+}
+}  // namespace
+
+double spearman(const std::vector<std::pair<double, double>>& xy) {
+  if (xy.size() < 3) return std::nan("");
+  std::vector<double> x, y;
+  for (const auto& [a, b] : xy) x.push_back(a), y.push_back(b);
+  const auto rx = ranks(x), ry = ranks(y);
+  const double n = static_cast<double>(xy.size()), mean = (n - 1) / 2;
+  double sxy = 0, sxx = 0, syy = 0;
+  for (std::size_t i = 0; i < xy.size(); ++i) {
+    sxy += (rx[i] - mean) * (ry[i] - mean);
+    sxx += (rx[i] - mean) * (rx[i] - mean);
+    syy += (ry[i] - mean) * (ry[i] - mean);
+  }
+  return sxx > 0 && syy > 0 ? sxy / std::sqrt(sxx * syy) : std::nan("");
+}
+
+void UncertaintyCheck::add(const skeleton::Skeleton& estimate, const skeleton::Skeleton& truth) {
+  for (std::size_t j = 0; j < skeleton::kJointCount; ++j) {
+    const auto& e = estimate.joints[j];
+    if (group_of(skeleton::joint_at(j)) < 0 || e.confidence < skeleton::kTracked || !skeleton::has_covariance(e)) continue;
+    const Eigen::Matrix3d c = skeleton::covariance_of(e);
+    const Eigen::LLT<Eigen::Matrix3d> llt(c);
+    if (llt.info() != Eigen::Success) continue;  // not a covariance
+    const Eigen::Vector3d d = e.position - truth.joints[j].position;
+    ++n_;
+    if (d.dot(llt.solve(d)) <= kChi2Of3At95) ++inside_;
+    const std::pair<double, double> sample{std::sqrt(c.trace() / 3.0), d.norm()};
+    if (kept_.size() < kKeptForSpearman) {
+      kept_.push_back(sample);
+    } else {
+      rng_ = rng_ * 6364136223846793005ULL + 1442695040888963407ULL;  // reservoir sampling, fixed seed
+      const std::uint64_t slot = (rng_ >> 11) % n_;
+      if (slot < kKeptForSpearman) kept_[slot] = sample;
+    }
+  }
+}
+
+double UncertaintyCheck::inside_95_pct() const {
+  return n_ > 0 ? 100.0 * static_cast<double>(inside_) / static_cast<double>(n_) : std::nan("");
+}
+
+double UncertaintyCheck::sigma_error_spearman() const { return spearman(kept_); }
+
+double UncertaintyCheck::median_sigma_cm() const {
+  if (kept_.empty()) return std::nan("");
+  std::vector<double> s;
+  for (const auto& [sigma, err] : kept_) s.push_back(sigma);
+  std::nth_element(s.begin(), s.begin() + static_cast<std::ptrdiff_t>(s.size() / 2), s.end());
+  return 100.0 * s[s.size() / 2];
 }
 
 }  // namespace skelgraph::eval

@@ -240,6 +240,7 @@ struct Evaluator::Impl {
       const auto t = truth.at(at, *c);
       if (!t || ((*t)[skeleton::JointId::Torso].position - *c).norm() > 1.0) continue;  // a ghost, not the person
       lane.score.accuracy.add(f, *t);
+      lane.score.uncertainty.add(f, *t);
       scored = true;
       if (at - first_truth < static_cast<std::int64_t>(options.compensation_s * 1e9)) {
         const auto before = truth.at(at - 100'000'000, (*t)[skeleton::JointId::Torso].position);

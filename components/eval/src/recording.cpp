@@ -51,6 +51,11 @@ nlohmann::json stream_json(const StreamScore& s) {
           {"upper_body_complete_pct", s.steadiness.upper_body_complete_pct()},
           {"upper_body_complete_when_a_single_sensor_is_pct", s.complete_when_single_pct()},
           {"bone_length_sd_cm", num(s.steadiness.mean_bone_sd_cm())},
+          {"uncertainty",
+           {{"joint_ticks", s.uncertainty.joint_ticks()},
+            {"inside_95_pct", num(s.uncertainty.inside_95_pct())},
+            {"sigma_error_spearman", num(s.uncertainty.sigma_error_spearman())},
+            {"median_sigma_cm", num(s.uncertainty.median_sigma_cm())}}},
           {"ticks", s.ticks},
           {"ticks_with_output", s.with_output}};
 }

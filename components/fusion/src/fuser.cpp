@@ -95,6 +95,11 @@ struct Track {
   std::array<JointFilter, kJointCount> filters;
   std::array<int, kJointCount> misses{};
   std::array<std::int64_t, kJointCount> last_update_ns{};
+  // Per joint: the variance of the latest instant's measurements combined
+  // (1 / sum of 1/sigma^2), m^2: their errors are correlated over time (the
+  // trackers' offsets and slowly wandering bias), so the filter's own
+  // covariance, which averages them as if independent, is not all of it.
+  std::array<double, kJointCount> instant_var{};
   std::array<double, std::size(kLimbs)> bone_sum{}, bone_n{};
   skeleton::Skeleton last;  // last output
   std::uint64_t frames = 0;
@@ -431,6 +436,7 @@ struct Fuser::Impl {
         if (!v->occluded && v->s.joints[j].confidence >= kInferred) meas.emplace_back(v, measurement_sigma(*v, j));
       }
       bool tracked = false, any = false;
+      double info = 0;  // sum of 1/sigma^2 of the measurements used this step
       // Every sensor's measurement fell outside the gate, but two or more of
       // them agree with each other: it is the filter that is off (a fast
       // movement its constant velocity did not follow), not the sensors.
@@ -474,6 +480,7 @@ struct Fuser::Impl {
           const double w = 1.0 / (s * s);
           sum += w * v->s.joints[j].position;
           wsum += w;
+          info += w;
           sig = std::max(sig, s);
           oj.sensor_mask |= 1u << v->sensor;
           tracked = tracked || v->s.joints[j].confidence >= kTracked;
@@ -491,6 +498,7 @@ struct Fuser::Impl {
             continue;
           }
           f.update(z, s);
+          info += 1.0 / (s * s);
           oj.sensor_mask |= 1u << v->sensor;
           tracked = tracked || v->s.joints[j].confidence >= kTracked;
           any = true;
@@ -504,6 +512,9 @@ struct Fuser::Impl {
       }
       if (!f.initialised()) continue;
       oj.position = f.position();
+      // Published uncertainty: the filter's covariance plus what the latest measurements cannot average away.
+      if (info > 0) tr.instant_var[j] = 1.0 / info;
+      skeleton::set_covariance(oj, f.position_covariance() + tr.instant_var[j] * Eigen::Matrix3d::Identity());
       oj.confidence = tracked ? kTracked : (any || t - tr.last_update_ns[j] <= kCoastNs ? kInferred : 0.0f);
     }
     // Limbs keep their length: learn each from confident frames, then pull the child towards it.

@@ -31,6 +31,18 @@ std::optional<Eigen::Vector3d> claimed_facing(const Skeleton& s, const Eigen::Ve
   return Eigen::Vector3d(f.normalized());
 }
 
+Eigen::Matrix3d covariance_of(const Joint& j) {
+  const auto& c = j.covariance;
+  Eigen::Matrix3d m;
+  m << c[0], c[1], c[2], c[1], c[3], c[4], c[2], c[4], c[5];
+  return m;
+}
+
+void set_covariance(Joint& j, const Eigen::Matrix3d& c) {
+  j.covariance = {static_cast<float>(c(0, 0)), static_cast<float>(c(0, 1)), static_cast<float>(c(0, 2)),
+                  static_cast<float>(c(1, 1)), static_cast<float>(c(1, 2)), static_cast<float>(c(2, 2))};
+}
+
 std::optional<Eigen::Vector3d> centre_of(const skeleton::Skeleton& s) {
   const auto& torso = s[JointId::Torso];
   if (torso.confidence > 0) return torso.position;

@@ -47,6 +47,28 @@ class Accumulator {
   std::array<double, kGroupCount> joint_frames_{}, tracked_{}, error_sum_{};
 };
 
+// Is the published uncertainty honest? For every tracked upper-body joint
+// that carries a covariance: whether the truth lies inside its 95 % region
+// (squared Mahalanobis distance within chi-square(3) 7.815), and how well
+// its sigma (the root of the mean variance) ranks the actual error
+// (Spearman; from up to 200 000 joint-ticks kept by reservoir sampling with
+// a fixed seed, so memory stays bounded and runs repeat exactly).
+class UncertaintyCheck {
+ public:
+  void add(const skeleton::Skeleton& estimate, const skeleton::Skeleton& truth);
+  std::uint64_t joint_ticks() const { return n_; }
+  double inside_95_pct() const;     // NaN when none
+  double sigma_error_spearman() const;  // NaN with fewer than 3
+  double median_sigma_cm() const;   // NaN when none
+
+ private:
+  std::uint64_t n_ = 0, inside_ = 0, rng_ = 0x9e3779b97f4a7c15ULL;
+  std::vector<std::pair<double, double>> kept_;  // (sigma, error), m
+};
+
+// Spearman's rank correlation of paired values (ties get their mean rank); NaN with fewer than 3 or no spread.
+double spearman(const std::vector<std::pair<double, double>>& xy);
+
 // Ground truth of each person over time; linear interpolation between samples.
 class TruthTimeline {
  public:

@@ -61,6 +61,7 @@ struct StreamScore {
   Accumulator after_calibration;  // the same ticks as `compensated`, offsets kept (the fair comparison)
   Accumulator compensated;        // after the calibration segment, with per-joint offsets removed
   Steadiness steadiness;
+  UncertaintyCheck uncertainty;   // against truth, the joints that carry a covariance (kalman)
   std::uint64_t ticks = 0, with_output = 0;
   // Ticks on which some single sensor had the whole upper body at confidence
   // 1, and of those, the ticks this stream had it too: how much of what any

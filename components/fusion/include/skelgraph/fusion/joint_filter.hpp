@@ -29,6 +29,7 @@ class JointFilter {
   Eigen::Vector3d position() const { return x_.head<3>(); }
   Eigen::Vector3d velocity() const { return x_.tail<3>(); }
   double position_sigma() const;  // sqrt of the mean positional variance
+  Eigen::Matrix3d position_covariance() const { return P_.topLeftCorner<3, 3>(); }
   std::int64_t time_ns() const { return t_ns_; }
 
  private:

@@ -48,7 +48,19 @@ struct Joint {
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
   float confidence = kLost;
   std::uint32_t sensor_mask = 0;  // fused output: which inputs contributed
+  // Fused output: the position's uncertainty, the covariance's upper
+  // triangle xx xy xz yy yz zz in m^2 (all 0: not given).
+  std::array<float, 6> covariance{};
 };
+
+// A joint's covariance as a matrix, and set from one (upper triangle kept).
+Eigen::Matrix3d covariance_of(const Joint& j);
+void set_covariance(Joint& j, const Eigen::Matrix3d& c);
+inline bool has_covariance(const Joint& j) {
+  for (const float v : j.covariance)
+    if (v != 0.0f) return true;
+  return false;
+}
 
 struct Skeleton {
   std::string sensor_id;
