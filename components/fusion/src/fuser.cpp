@@ -95,11 +95,18 @@ struct Track {
   std::array<JointFilter, kJointCount> filters;
   std::array<int, kJointCount> misses{};
   std::array<std::int64_t, kJointCount> last_update_ns{};
-  // Per joint: the variance of the latest instant's measurements combined
-  // (1 / sum of 1/sigma^2), m^2: their errors are correlated over time (the
-  // trackers' offsets and slowly wandering bias), so the filter's own
-  // covariance, which averages them as if independent, is not all of it.
-  std::array<double, kJointCount> instant_var{};
+  // Per joint, what the latest instant's measurements say about the
+  // uncertainty that the filter's own covariance, averaging them over time
+  // as if independent, leaves out (their errors are correlated over time:
+  // the trackers' offsets and slowly wandering bias): their variance
+  // combined (1 / sum of 1/sigma^2) and how far apart they are (their
+  // 1/sigma^2-weighted spread about the estimate), m^2.
+  std::array<Eigen::Matrix3d, kJointCount> instant_cov = zero_covariances();
+  static std::array<Eigen::Matrix3d, kJointCount> zero_covariances() {
+    std::array<Eigen::Matrix3d, kJointCount> z;
+    z.fill(Eigen::Matrix3d::Zero());
+    return z;
+  }
   std::array<double, std::size(kLimbs)> bone_sum{}, bone_n{};
   skeleton::Skeleton last;  // last output
   std::uint64_t frames = 0;
@@ -358,6 +365,7 @@ struct Fuser::Impl {
       } else if (m == Method::Weighted) {
         Vector3d sum = Vector3d::Zero();
         double wsum = 0;
+        std::vector<std::pair<const View*, double>> used;  // with its weight
         for (const View* v : vs) {
           const auto& jj = v->s.joints[j];
           if (jj.confidence < kInferred) continue;
@@ -365,9 +373,21 @@ struct Fuser::Impl {
           const double w = (jj.confidence >= kTracked ? 1.0 : 0.15) * (0.25 + 0.75 * (v->facing + 1) / 2) / (d * d);
           sum += w * jj.position;
           wsum += w;
+          used.emplace_back(v, w);
           out.sensor_mask |= 1u << v->sensor;
         }
         out.position = sum / wsum;
+        // Uncertainty: how far apart the views are (their weighted spread about the
+        // result) plus the measurement model's variance of the views combined.
+        Eigen::Matrix3d spread = Eigen::Matrix3d::Zero();
+        double info = 0;
+        for (const auto& [v, w] : used) {
+          const Vector3d e = v->s.joints[j].position - out.position;
+          spread += w * e * e.transpose();
+          const double s = measurement_sigma(*v, j);
+          info += 1.0 / (s * s);
+        }
+        skeleton::set_covariance(out, spread / wsum + Eigen::Matrix3d::Identity() / info);
       } else {
         const auto score = [&](const View* v) { return m == Method::Sum ? v->conf_sum : v->facing; };
         const View* best = *std::max_element(cand.begin(), cand.end(),
@@ -436,7 +456,7 @@ struct Fuser::Impl {
         if (!v->occluded && v->s.joints[j].confidence >= kInferred) meas.emplace_back(v, measurement_sigma(*v, j));
       }
       bool tracked = false, any = false;
-      double info = 0;  // sum of 1/sigma^2 of the measurements used this step
+      std::vector<std::pair<Vector3d, double>> used;  // the measurements used this step, with their sigma
       // Every sensor's measurement fell outside the gate, but two or more of
       // them agree with each other: it is the filter that is off (a fast
       // movement its constant velocity did not follow), not the sensors.
@@ -480,7 +500,7 @@ struct Fuser::Impl {
           const double w = 1.0 / (s * s);
           sum += w * v->s.joints[j].position;
           wsum += w;
-          info += w;
+          used.emplace_back(v->s.joints[j].position, s);
           sig = std::max(sig, s);
           oj.sensor_mask |= 1u << v->sensor;
           tracked = tracked || v->s.joints[j].confidence >= kTracked;
@@ -498,7 +518,7 @@ struct Fuser::Impl {
             continue;
           }
           f.update(z, s);
-          info += 1.0 / (s * s);
+          used.emplace_back(z, s);
           oj.sensor_mask |= 1u << v->sensor;
           tracked = tracked || v->s.joints[j].confidence >= kTracked;
           any = true;
@@ -513,8 +533,17 @@ struct Fuser::Impl {
       if (!f.initialised()) continue;
       oj.position = f.position();
       // Published uncertainty: the filter's covariance plus what the latest measurements cannot average away.
-      if (info > 0) tr.instant_var[j] = 1.0 / info;
-      skeleton::set_covariance(oj, f.position_covariance() + tr.instant_var[j] * Eigen::Matrix3d::Identity());
+      if (!used.empty()) {
+        Eigen::Matrix3d spread = Eigen::Matrix3d::Zero();
+        double info = 0;
+        for (const auto& [z, s] : used) {
+          const Vector3d e = z - oj.position;
+          spread += e * e.transpose() / (s * s);
+          info += 1.0 / (s * s);
+        }
+        tr.instant_cov[j] = (spread + Eigen::Matrix3d::Identity()) / info;
+      }
+      skeleton::set_covariance(oj, f.position_covariance() + tr.instant_cov[j]);
       oj.confidence = tracked ? kTracked : (any || t - tr.last_update_ns[j] <= kCoastNs ? kInferred : 0.0f);
     }
     // Limbs keep their length: learn each from confident frames, then pull the child towards it.
