@@ -360,6 +360,8 @@ RecordingReport eval_recording_section(const std::string& file, const std::strin
 
 int eval_sim(const SimEvalOptions& o) {
   eval::OfflineOptions eo = eval::offline_options(o.methods, o.delay_ms, o.max_age_ms);
+  eo.fuser.predict_ns = static_cast<std::int64_t>(o.predict_ms * 1e6);
+  eo.use_delay_ns = static_cast<std::int64_t>(o.use_delay_ms * 1e6);
   eo.trace = !o.report_dir.empty();
   std::string html;
   if (eo.trace) std::filesystem::create_directories(o.report_dir);
@@ -452,7 +454,11 @@ int eval_sim(const SimEvalOptions& o) {
     if (!o.json && !o.quiet) std::printf("\nreport: %s\n", path.c_str());
   }
   if (o.json && !o.quiet) {
-    std::printf("%s\n", nlohmann::json{{"delay_ms", o.delay_ms}, {"max_age_ms", o.max_age_ms}, {"scenarios", out}}
+    std::printf("%s\n", nlohmann::json{{"delay_ms", o.delay_ms},
+                                       {"max_age_ms", o.max_age_ms},
+                                       {"predict_ms", o.predict_ms},
+                                       {"use_delay_ms", o.use_delay_ms},
+                                       {"scenarios", out}}
                             .dump(2)
                             .c_str());
   }
@@ -496,6 +502,13 @@ void add_eval_command(CLI::App& app, GlobalOptions& g, Action& run) {
   s->add_option("-p,--param", o->params, "simulator parameter NAME=VALUE (as the sim component's; e.g. sensor_count=2)");
   s->add_option("--scenarios", o->scenarios, "scenarios to run (default: the thesis's seven)")->delimiter(',');
   add_fusion_options(s, o->methods, o->delay_ms, o->max_age_ms, "fusion methods (default: all)");
+  s->add_option("--predict-ms", o->predict_ms,
+                "kalman: predict each joint this far past the fusion time (the trackers' delay plus the consumer's)")
+      ->check(CLI::Range(0.0, 1000.0));
+  s->add_option("--use-delay-ms", o->use_delay_ms,
+                "score every stream against the truth this long after each output: where the person is when a "
+                "consumer uses it (default 0: at the output's own time)")
+      ->check(CLI::Range(0.0, 1000.0));
   s->add_flag("--json", o->json, "machine-readable results");
   s->add_option("--source", o->source,
                 "raw skeletons from: tracker (the simulator's tracker model) or depth (rendered depth images through "

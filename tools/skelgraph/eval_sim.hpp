@@ -12,6 +12,8 @@ struct SimEvalOptions {
   // -p NAME=VALUE for the simulator; the scenarios to run; fusion methods (empty: all)
   std::vector<std::string> params, scenarios{"walk", "360", "hide", "box", "occ", "sit", "arms"}, methods;
   double delay_ms = 0, max_age_ms = 100;
+  double predict_ms = 0;    // kalman: predict each joint this far past the fusion time
+  double use_delay_ms = 0;  // score every stream against the truth this long after each output (time of use)
   // Where the raw skeletons come from: "tracker" (the simulator's tracker
   // model) or "depth" (rendered depth images through the open depth tracker).
   std::string source = "tracker";

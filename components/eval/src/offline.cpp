@@ -178,7 +178,7 @@ struct Evaluator::Impl {
     ++result.ticks;
     const std::int64_t at = tick - options.fuser.delay_ns;
     truth.forget_before(at - 1'000'000'000);
-    const bool truth_here = truth.covers(at);
+    const bool truth_here = truth.covers(at + options.use_delay_ns);
     std::vector<bool> complete(lanes.size(), false);  // a skeleton of the lane has the whole upper body at confidence 1
     for (std::size_t i = 0; i < lanes.size(); ++i) {
       auto& lane = lanes[i];
@@ -206,7 +206,7 @@ struct Evaluator::Impl {
         complete[i] = complete[i] || upper_body_complete(f);
       }
       if (!truth_here) continue;
-      score(lane, fused, at);
+      score(lane, fused, at + options.use_delay_ns);
     }
     bool any_single = false;
     for (std::size_t i = 0; i < lanes.size(); ++i) any_single = any_single || (lanes[i].kind == Lane::Kind::Single && complete[i]);

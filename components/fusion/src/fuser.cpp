@@ -531,19 +531,21 @@ struct Fuser::Impl {
         }
       }
       if (!f.initialised()) continue;
-      oj.position = f.position();
+      JointFilter ahead = f;  // the output: the state now, or predicted to the moment of use
+      if (opt.predict_ns > 0) ahead.predict(t + opt.predict_ns);
+      oj.position = ahead.position();
       // Published uncertainty: the filter's covariance plus what the latest measurements cannot average away.
       if (!used.empty()) {
         Eigen::Matrix3d spread = Eigen::Matrix3d::Zero();
         double info = 0;
         for (const auto& [z, s] : used) {
-          const Vector3d e = z - oj.position;
+          const Vector3d e = z - f.position();
           spread += e * e.transpose() / (s * s);
           info += 1.0 / (s * s);
         }
         tr.instant_cov[j] = (spread + Eigen::Matrix3d::Identity()) / info;
       }
-      skeleton::set_covariance(oj, f.position_covariance() + tr.instant_cov[j]);
+      skeleton::set_covariance(oj, ahead.position_covariance() + tr.instant_cov[j]);
       oj.confidence = tracked ? kTracked : (any || t - tr.last_update_ns[j] <= kCoastNs ? kInferred : 0.0f);
     }
     // Limbs keep their length: learn each from confident frames, then pull the child towards it.

@@ -22,6 +22,9 @@ runtime::ComponentInfo FusionComponent::describe() {
       .add_double("sensor_timeout_ms", 1000.0, "a sensor silent this long is dropped (status DEGRADED)", 10.0, 60000.0)
       .add_double("person_timeout_ms", 1000.0, "a fused person with no input this long is forgotten", 10.0, 60000.0)
       .add_double("match_distance_m", 0.6, "a sensor's skeleton joins a fused person whose torso is this close", 0.05, 5.0)
+      .add_double("predict_ms", 0.0,
+                  "kalman: predict each joint this far past the fusion time (the trackers' delay plus the consumer's)",
+                  0.0, 1000.0)
       .add_string("output_id", "fused", "sensor_id of the fused skeletons (several fusion components: one each)");
   return info;
 }
@@ -35,6 +38,7 @@ FuserOptions options_from(const runtime::Params& p) {
   o.sensor_timeout_ns = static_cast<std::int64_t>(p.get<double>("sensor_timeout_ms") * 1e6);
   o.person_timeout_ns = static_cast<std::int64_t>(p.get<double>("person_timeout_ms") * 1e6);
   o.match_distance_m = p.get<double>("match_distance_m");
+  o.predict_ns = static_cast<std::int64_t>(p.get<double>("predict_ms") * 1e6);
   return o;
 }
 }  // namespace

@@ -44,6 +44,10 @@ struct OfflineOptions {
   // `compensation_s` of truth and removed afterwards (StreamScore::compensated).
   double compensation_s = 5.0;
   skeleton::JointId trace_joint = skeleton::JointId::RightHand;
+  // Every stream scored against the truth this long after each output's
+  // time: where the person is when a consumer uses it (0: at the output's
+  // own time). At most 1 s (the evaluation holds 2 s of truth ahead).
+  std::int64_t use_delay_ns = 0;
 };
 
 // One output tick of one stream, for plots.

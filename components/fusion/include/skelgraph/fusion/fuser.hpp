@@ -51,6 +51,10 @@ struct FuserOptions {
   std::int64_t sensor_timeout_ns = 1'000'000'000;  // silent this long: the sensor is dropped (degraded)
   std::int64_t person_timeout_ns = 1'000'000'000;  // no input this long: the fused person is forgotten
   double match_distance_m = 0.6;                   // a sensor's skeleton joins a fused person this close (torso)
+  // kalman: each joint predicted this far past the fusion time (its velocity
+  // and covariance carried forward): the trackers' own delay plus the
+  // consumer's, so the skeleton says where the person is when it is used.
+  std::int64_t predict_ns = 0;
 };
 
 struct FuserStats {
