@@ -65,7 +65,12 @@ void to_json(nlohmann::json& j, const Skeleton& v) {
   }
   j = {{"sensor_id", v.sensor_id()},     {"person_id", v.person_id()},
        {"frame_id", v.frame_id()},       {"stamp_ns", v.stamp_ns()},
-       {"frame_number", v.frame_number()}, {"joints", std::move(joints)}};
+       {"frame_number", v.frame_number()}, {"joints", std::move(joints)},
+       {"capture_oldest_ns", v.capture_oldest_ns()}, {"capture_newest_ns", v.capture_newest_ns()}};
+  nlohmann::json cov = nlohmann::json::array();
+  for (const auto& c : v.covariance())
+    cov.push_back({{"xx", c.xx()}, {"xy", c.xy()}, {"xz", c.xz()}, {"yy", c.yy()}, {"yz", c.yz()}, {"zz", c.zz()}});
+  j["covariance"] = std::move(cov);
 }
 void to_json(nlohmann::json& j, const SyncCommand& v) {
   j = {{"kind", to_string(v.kind())}, {"session_id", v.session_id()}, {"label", v.label()},

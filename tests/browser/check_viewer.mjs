@@ -67,6 +67,17 @@ try {
     out.toggle.restored = (await stats()).drawn.list.some((s) => s.stream === hidden.stream);
   }
 
+  // The uncertainty layer: each fused joint's 95 % sphere, hidden and shown again.
+  const u0 = (await stats()).drawn;
+  await page.uncheck('input[data-layer="uncertainty"]');
+  await sleep(300);
+  const u1 = (await stats()).drawn;
+  await page.check('input[data-layer="uncertainty"]');
+  await sleep(300);
+  const u2 = (await stats()).drawn;
+  const spheres = (d) => d.list.reduce((n, s) => n + s.uncertainty, 0);
+  out.uncertainty = { before: spheres(u0), hidden: spheres(u1), restored: spheres(u2) };
+
   // Pause freezes the view while frames keep arriving.
   await page.click('#pause');
   const p0 = await stats();

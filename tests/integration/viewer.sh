@@ -86,6 +86,13 @@ check(missing <= compared // 20, f"{missing} drawn skeletons not among the publi
 expected = {f"sensor{i + 1}" for i in range(sensors)} | {"fused", "truth"}
 check(expected <= streams, f"streams drawn: {sorted(streams)}, expected {sorted(expected)}; the viewer received "
       f"{ {k: v['rate_hz'] for k, v in page['streams'].items()} } Hz; samples echoed by topic echo: {echoed}")
+u = page["uncertainty"]
+check(u["before"] > 0 and u["hidden"] == 0 and u["restored"] > 0, f"uncertainty layer toggle: {u}")
+fused_spheres = [s for snap in page["snapshots"] for s in snap["list"] if s["kind"] == "fused"]
+check(all(0 < s["uncertainty"] <= s["joints"] and 0.005 < s["radius_95_max"] < 1.0 for s in fused_spheres),
+      f"fused skeletons without their 95 % spheres, or implausible radii: {fused_spheres[:3]}")
+check(all(s["uncertainty"] == 0 for snap in page["snapshots"] for s in snap["list"] if s["kind"] != "fused"),
+      "raw or truth skeletons drawn with uncertainty spheres")
 t = page.get("toggle")
 check(t and t["after"] == t["before"] - 1 and not t["still_drawn"] and t["restored"], f"layer toggle: {t}")
 p = page["pause"]

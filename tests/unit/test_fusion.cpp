@@ -14,6 +14,7 @@
 
 #include "skelgraph/eval/metrics.hpp"
 #include "skelgraph/eval/offline.hpp"
+#include "skelgraph/fusion/arrival_gate.hpp"
 #include "skelgraph/fusion/fuser.hpp"
 #include "skelgraph/fusion/joint_filter.hpp"
 #include "skelgraph/sim/simulation.hpp"
@@ -231,6 +232,46 @@ TEST(Fusion, InterpolatesBetweenTheSamplesAroundTheFusionTime) {
   ASSERT_EQ(out.size(), 1u);
   EXPECT_EQ(out[0].stamp_ns, 20 * kMs);
   EXPECT_NEAR(out[0][JointId::Torso].position.x(), 0.05, 1e-9);
+}
+
+TEST(Fusion, FusedSkeletonsCarryTheCaptureTimesOfTheirInputsOnTheFusersClock) {
+  for (const auto m : {fusion::Method::Kalman, fusion::Method::Avg}) {
+    auto f = make(m);
+    f.set_capture_latency("s2", 50 * kMs);  // s2's tracker shows the body 50 ms before its stamps
+    auto a = in_sensor(person("s1", 1, {0, 1, 0}), kS1);
+    auto b = in_sensor(person("s2", 4, {0.02, 1, 0}), kS2);
+    // s1's clock is 1 s ahead of ours, s2's 0.5 s behind; frames every 33 ms,
+    // delivered 2-6 ms after capture. The quickest delivery (2 ms, 1 ms) is
+    // taken as instantaneous: captures land 2 ms and 1 ms late.
+    const std::int64_t capture[] = {0, 33, 66}, delay1[] = {5, 2, 3}, delay2[] = {4, 1, 6};
+    for (int k = 0; k < 3; ++k) {
+      a.stamp_ns = (capture[k] + 1000) * kMs;
+      b.stamp_ns = (capture[k] + 10 - 500) * kMs;  // s2 captures 10 ms after s1
+      f.add(a, (capture[k] + delay1[k]) * kMs);
+      f.add(b, (capture[k] + 10 + delay2[k]) * kMs);
+    }
+    const auto out = f.fuse(82 * kMs);
+    ASSERT_EQ(out.size(), 1u) << fusion::method_name(m);
+    EXPECT_EQ(out[0].stamp_ns, 82 * kMs);
+    // s1's last frame: captured at 66 (68 on the shifted clock); s2's at 76 (77), less its 50 ms.
+    EXPECT_EQ(out[0].capture_oldest_ns, 27 * kMs) << fusion::method_name(m);
+    EXPECT_EQ(out[0].capture_newest_ns, 68 * kMs) << fusion::method_name(m);
+  }
+  // Interpolated between two samples: the capture time is interpolated alike.
+  fusion::FuserOptions o;
+  o.method = fusion::Method::Avg;
+  o.delay_ns = 40 * kMs;
+  fusion::Fuser f(o);
+  f.set_pose("s1", Eigen::Isometry3d::Identity());
+  auto p = person("s1", 1, {0, 1, 0});
+  p.stamp_ns = 5000 * kMs;  // (its clock: 4 s ahead, 10 ms delivery)
+  f.add(p, 1010 * kMs);
+  p.stamp_ns = 5040 * kMs;
+  f.add(p, 1050 * kMs);
+  const auto out = f.fuse(1070 * kMs);  // describes 1030 ms: between the arrivals 1010 and 1050
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].capture_oldest_ns, 1030 * kMs);
+  EXPECT_EQ(out[0].capture_newest_ns, 1030 * kMs);
 }
 
 TEST(Fusion, PeopleStayApartAndKeepTheirIdsWhenOneSensorLosesThem) {
@@ -663,4 +704,56 @@ TEST(Evaluation, EventsOutOfOrderAndLateSensorsAreHandled) {
   EXPECT_EQ(r.streams[2].name, "avg");
   EXPECT_FALSE(r.streams[1].fused);
   EXPECT_EQ(r.streams[1].ticks, r.ticks);
+}
+
+TEST(ArrivalGate, FusesWhenEverySensorsFrameIsWholeInEitherOrder) {
+  using Ready = fusion::ArrivalGate::Ready;
+  fusion::ArrivalGate g(10 * kMs);
+  const std::vector<std::string> live{"s1", "s2"};
+  EXPECT_EQ(g.ready(live, 0), Ready::NotYet);
+  // s1's frame 5: two skeletons, then its SensorFrame: whole.
+  g.skeleton("s1", 5, 1 * kMs);
+  g.skeleton("s1", 5, 1 * kMs);
+  EXPECT_EQ(g.ready(live, 1 * kMs), Ready::NotYet);  // (no SensorFrame yet: s1 may not announce)
+  g.frame("s1", 5, 2, 2 * kMs);
+  EXPECT_EQ(g.ready(live, 2 * kMs), Ready::NotYet);  // s2 has delivered nothing
+  ASSERT_TRUE(g.deadline());
+  // s2's frame 9: the SensorFrame first, saying one skeleton, which comes after.
+  g.frame("s2", 9, 1, 4 * kMs);
+  EXPECT_EQ(g.ready(live, 4 * kMs), Ready::NotYet);
+  g.skeleton("s2", 9, 5 * kMs);
+  EXPECT_EQ(g.ready(live, 5 * kMs), Ready::AllArrived);
+  g.fused(Ready::AllArrived);
+  EXPECT_EQ(g.ready(live, 5 * kMs), Ready::NotYet);
+  EXPECT_FALSE(g.deadline());
+  // Next round: only s1 delivers; the wait runs out 10 ms after its frame.
+  g.frame("s1", 6, 0, 34 * kMs);  // a frame with nobody in it is whole at once
+  EXPECT_EQ(g.ready(live, 43 * kMs), Ready::NotYet);
+  EXPECT_EQ(*g.deadline(), 44 * kMs);
+  EXPECT_EQ(g.ready(live, 44 * kMs), Ready::WaitedOut);
+  g.fused(Ready::WaitedOut);
+  // s2 dropped out of the live set: s1 alone decides.
+  g.frame("s1", 7, 0, 67 * kMs);
+  EXPECT_EQ(g.ready({"s1"}, 67 * kMs), Ready::AllArrived);
+  // A repeated or older frame number is not new.
+  g.fused(Ready::AllArrived);
+  g.frame("s1", 7, 0, 70 * kMs);
+  g.frame("s1", 3, 0, 70 * kMs);
+  EXPECT_EQ(g.ready({"s1"}, 70 * kMs), Ready::NotYet);
+  EXPECT_EQ(g.counts().all_arrived, 2u);
+  EXPECT_EQ(g.counts().waited_out, 1u);
+  EXPECT_EQ(g.counts().whole_frames, 4u);
+}
+
+TEST(ArrivalGate, ASensorWithoutFrameHeartbeatsCompletesAFrameWithEachNewFrameNumber) {
+  using Ready = fusion::ArrivalGate::Ready;
+  fusion::ArrivalGate g(10 * kMs);
+  g.skeleton("player", 1, 0);
+  EXPECT_EQ(g.ready({"player"}, 0), Ready::AllArrived);
+  g.fused(Ready::AllArrived);
+  g.skeleton("player", 1, 1 * kMs);  // a second person of the same frame
+  EXPECT_EQ(g.ready({"player"}, 1 * kMs), Ready::NotYet);
+  g.skeleton("player", 2, 33 * kMs);
+  EXPECT_EQ(g.ready({"player"}, 33 * kMs), Ready::AllArrived);
+  EXPECT_EQ(g.ready({}, 33 * kMs), Ready::NotYet);  // nobody live: nothing to wait for, nor to fuse on
 }

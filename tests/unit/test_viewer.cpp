@@ -70,6 +70,27 @@ TEST(ViewerScene, APersonWhoLeftIsNoLongerDrawn) {
   EXPECT_EQ(f["skeletons"][0]["person"], 2);
 }
 
+TEST(ViewerScene, FusedJointsCarryTheRadiusOfTheir95PercentRegion) {
+  skeleton::Joint j;
+  EXPECT_EQ(radius_95(j), 0.0);
+  // Variances 4 cm^2 along x, 1 cm^2 along y and z: the largest axis, sqrt(7.815 * 0.0004) = 5.59 cm.
+  skeleton::set_covariance(j, Eigen::Vector3d(0.0004, 0.0001, 0.0001).asDiagonal());
+  EXPECT_NEAR(radius_95(j), 0.05591, 1e-5);
+  // Rotated, the same ellipsoid has the same sphere.
+  const Eigen::Matrix3d r = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  skeleton::set_covariance(j, r * Eigen::Vector3d(0.0004, 0.0001, 0.0001).asDiagonal() * r.transpose());
+  EXPECT_NEAR(radius_95(j), 0.05591, 1e-4);
+  Scene scene;
+  auto s = person("fused", 3, "world", 9);
+  skeleton::set_covariance(s.joints[5], Eigen::Matrix3d::Identity() * 0.0001);
+  scene.on_skeleton(s, 0);
+  const auto f = scene.frame(1 * kMs);
+  const auto* drawn = find_skeleton(f, "fused");
+  ASSERT_NE(drawn, nullptr);
+  EXPECT_NEAR((*drawn)["joints"][5][4].get<double>(), 0.028, 1e-9);  // sqrt(7.815e-4) = 27.96 mm
+  EXPECT_EQ((*drawn)["joints"][4][4].get<double>(), 0.0);
+}
+
 TEST(ViewerScene, RawSkeletonsArePlacedWithTheirSensorsPose) {
   Scene scene;
   auto s = person("sensor1", 1, "sensor1", 7);
@@ -102,7 +123,8 @@ TEST(ViewerScene, RawSkeletonsArePlacedWithTheirSensorsPose) {
   EXPECT_NEAR(joints[0][2].get<double>(), 0.0, 1e-9);
   EXPECT_EQ(joints[0][3], 2);
   EXPECT_EQ(joints[3][3], 1);
-  EXPECT_EQ(joints[4], nlohmann::json::array({0, 0, 0, 0}));
+  EXPECT_EQ(joints[4], nlohmann::json::array({0, 0, 0, 0, 0}));
+  EXPECT_EQ(joints[0][4], 0.0);  // a raw skeleton: no covariance, no sphere
   EXPECT_EQ(f["unplaced"].size(), 0u);
   ASSERT_EQ(f["sensors"].size(), 1u);
   EXPECT_EQ(f["sensors"][0]["position"], nlohmann::json::array({3.0, 0.0, 0.0}));

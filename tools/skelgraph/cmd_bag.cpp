@@ -18,6 +18,7 @@
 #include "skelgraph/mcap/mcap.hpp"
 #include "skelgraph/msg/cdr.hpp"
 #include "skelgraph/msg/json.hpp"
+#include "skelgraph/msg/schema.hpp"
 #include "skelgraph/playback/readers.hpp"
 #include "skelgraph/recording/bag.hpp"
 #include "skelgraph/recording/session_recorder.hpp"
@@ -76,7 +77,7 @@ nlohmann::json info_of(const std::string& file) {
   std::set<std::uint32_t> sessions;
   std::map<std::string, std::uint64_t> per_sensor, ticks_with;
   AckTally acks;
-  std::uint64_t tick_records = 0;
+  std::uint64_t tick_records = 0, older_skeletons = 0;
   std::map<std::string, nlohmann::json> clocks;
   reader.for_each_message([&](const mcap::Channel& ch, const mcap::Schema* schema, const mcap::Message& m) {
     if (schema == nullptr) return;
@@ -94,6 +95,7 @@ nlohmann::json info_of(const std::string& file) {
     } else if (schema->name == msg::MessageTraits<msg::Skeleton>::name) {
       const auto k = msg::from_cdr<msg::Skeleton>(m.data.data(), m.data.size());
       ++per_sensor[ch.topic + " " + k.sensor_id().to_string()];
+      if (msg::may_be_older_schema(schema->name, schema->data)) ++older_skeletons;
     } else if (schema->name == msg::MessageTraits<msg::TickFrames>::name) {
       const auto t = msg::from_cdr<msg::TickFrames>(m.data.data(), m.data.size());
       ++tick_records;
@@ -123,6 +125,11 @@ nlohmann::json info_of(const std::string& file) {
   if (s.chunk_count > 0 && !s.has_message_indexes) notes.push_back("no message indexes: chunks read whole");
   if (s.attachment_count > 0 && !s.has_attachment_indexes) notes.push_back("no attachment index: attachments found by scanning");
   if (!s.metadata.empty() && !s.has_metadata_indexes) notes.push_back("no metadata index: metadata found by scanning");
+  if (older_skeletons > 0) {
+    notes.push_back(std::to_string(older_skeletons) +
+                    " skeletons in schema 1 (recorded before capture stamps and covariance were on the wire): read "
+                    "with capture stamps = stamp_ns and no covariance; bag merge rewrites them in the current schema");
+  }
   const nlohmann::json out{{"file", file},
                            {"valid", problem.empty()},
                            {"problem", problem},
@@ -147,6 +154,7 @@ nlohmann::json info_of(const std::string& file) {
                            {"sessions", sessions},
                            {"topics", topics},
                            {"skeletons_per_sensor", per_sensor},
+                           {"skeletons_older_schema", older_skeletons},
                            {"ticks_acked_by_host", acks.by_host()},
                            {"tick_records", tick_records},
                            {"ticks_with_frames_of", ticks_with},
@@ -345,8 +353,13 @@ int merge(const std::vector<std::string>& files, const std::string& out_path, mc
     const double at = it == clocks.end() ? 0.0 : static_cast<double>(it->second.stamp_ns());
     applied[inputs[i].file] = {{"host", inputs[i].host}, {"offset_ns", offset}, {"drift_ppm", drift * 1e6},
                                {"estimated", it != clocks.end()}};
-    readers[i]->for_each_message([&](const mcap::Channel& ch, const mcap::Schema*, const mcap::Message& m) {
-      const std::string data(m.data);
+    readers[i]->for_each_message([&](const mcap::Channel& ch, const mcap::Schema* schema, const mcap::Message& m) {
+      const auto type = ch.metadata.count("dds_type") ? ch.metadata.at("dds_type") : std::string();
+      // Older schemas are written in the current one (the merged file's schema is the current IDL).
+      const auto upgraded = msg::may_be_older_schema(type, schema ? schema->data : std::string())
+                                ? msg::upgrade_cdr(type, m.data.data(), m.data.size())
+                                : std::nullopt;
+      const std::string data = upgraded ? std::string(upgraded->begin(), upgraded->end()) : std::string(m.data);
       const auto [where, fresh] = seen.emplace(std::make_pair(ch.topic, data), i);
       if (!fresh && where->second != i) {  // another host recorded the same sample
         ++duplicates;
@@ -355,7 +368,6 @@ int merge(const std::vector<std::string>& files, const std::string& out_path, mc
       // Host clock -> master clock: subtract the offset the host had at that moment.
       const double t = static_cast<double>(m.log_time);
       const double corrected = t - (offset + drift * (t - at));
-      const auto type = ch.metadata.count("dds_type") ? ch.metadata.at("dds_type") : std::string();
       const bool keyed = ch.metadata.count("keyed") && ch.metadata.at("keyed") == "true";
       if (ch.topic == runtime::topics::kSyncAck.name) {
         acks.ack(msg::from_cdr<msg::SyncAck>(m.data.data(), m.data.size()));

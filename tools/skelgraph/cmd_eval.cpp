@@ -494,6 +494,18 @@ void add_fuse_command(CLI::App& app, GlobalOptions&, Action& run) {
   });
 }
 
+// Prediction and scoring at the time of use, the same for every eval command.
+void add_time_of_use_options(CLI::App* s, double& predict_ms, double& use_delay_ms) {
+  s->add_option("--predict-ms", predict_ms,
+                "kalman: predict each joint this far past the fusion time (the trackers' delay plus the consumer's)")
+      ->check(CLI::Range(0.0, 1000.0));
+  s->add_option("--use-delay-ms", use_delay_ms,
+                "score every stream against the truth this long after each output: where the person is when a "
+                "consumer uses it, e.g. the measured pipeline delay (bench/latency_bench.sh) plus the consumer's "
+                "cycle (default 0: at the output's own time)")
+      ->check(CLI::Range(0.0, 1000.0));
+}
+
 void add_eval_command(CLI::App& app, GlobalOptions& g, Action& run) {
   auto* ev = app.add_subcommand("eval", "Score single sensors and fusion methods against ground truth");
   ev->require_subcommand(1);
@@ -502,13 +514,7 @@ void add_eval_command(CLI::App& app, GlobalOptions& g, Action& run) {
   s->add_option("-p,--param", o->params, "simulator parameter NAME=VALUE (as the sim component's; e.g. sensor_count=2)");
   s->add_option("--scenarios", o->scenarios, "scenarios to run (default: the thesis's seven)")->delimiter(',');
   add_fusion_options(s, o->methods, o->delay_ms, o->max_age_ms, "fusion methods (default: all)");
-  s->add_option("--predict-ms", o->predict_ms,
-                "kalman: predict each joint this far past the fusion time (the trackers' delay plus the consumer's)")
-      ->check(CLI::Range(0.0, 1000.0));
-  s->add_option("--use-delay-ms", o->use_delay_ms,
-                "score every stream against the truth this long after each output: where the person is when a "
-                "consumer uses it (default 0: at the output's own time)")
-      ->check(CLI::Range(0.0, 1000.0));
+  add_time_of_use_options(s, o->predict_ms, o->use_delay_ms);
   s->add_flag("--json", o->json, "machine-readable results");
   s->add_option("--source", o->source,
                 "raw skeletons from: tracker (the simulator's tracker model) or depth (rendered depth images through "
@@ -529,6 +535,7 @@ void add_eval_command(CLI::App& app, GlobalOptions& g, Action& run) {
       ->required()
       ->check(CLI::ExistingFile);
   add_fusion_options(r, fo->methods, fo->delay_ms, fo->max_age_ms, "fusion methods (default: all)");
+  add_time_of_use_options(r, fo->predict_ms, fo->use_delay_ms);
   r->add_flag("--json", fo->json, "machine-readable results");
   r->add_flag("--shared-frame", fo->shared_frame, "the sensors' skeletons are already in one frame (e.g. KinectMultiTrack): no poses needed");
   r->add_option("--calibration", fo->calibration, "sensor poses from this calibration file (YAML) instead of the recording's")
@@ -545,6 +552,7 @@ void add_eval_command(CLI::App& app, GlobalOptions& g, Action& run) {
   l->add_option("--duration", lo->duration, "seconds to record (Ctrl-C ends it sooner)")->check(kPositive);
   l->add_option("--dir", lo->dir, "directory for the recording (kept; default: a new one under the temp directory)");
   add_fusion_options(l, lo->score.methods, lo->score.delay_ms, lo->score.max_age_ms, "fusion methods (default: all)");
+  add_time_of_use_options(l, lo->score.predict_ms, lo->score.use_delay_ms);
   l->add_flag("--json", lo->score.json, "machine-readable results");
   l->add_flag("--shared-frame", lo->score.shared_frame, "the sensors' skeletons are already in one frame: no poses needed");
   l->add_option("--calibration", lo->score.calibration, "sensor poses from this calibration file (YAML) instead of the topic's")

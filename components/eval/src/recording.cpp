@@ -160,6 +160,8 @@ OfflineOptions offline_options(const std::vector<std::string>& methods, double d
 OfflineOptions offline_options(const RecordingOptions& o, const RecordingInputs& in) {
   auto eo = offline_options(o.methods, o.delay_ms, o.max_age_ms);
   eo.tick_times = in.ticks;
+  eo.fuser.predict_ns = static_cast<std::int64_t>(o.predict_ms * 1e6);
+  eo.use_delay_ns = static_cast<std::int64_t>(o.use_delay_ms * 1e6);
   return eo;
 }
 
@@ -180,6 +182,8 @@ ScoredRecording score_recording(const std::string& file, const RecordingOptions&
                {"raw_skeletons", s.in.raw},
                {"truth_skeletons", s.in.truth},
                {"live_fused_skeletons", s.in.fused},
+               {"predict_ms", o.predict_ms},
+               {"use_delay_ms", o.use_delay_ms},
                {"streams", streams}};
   return s;
 }

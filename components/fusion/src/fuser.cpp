@@ -66,7 +66,21 @@ struct SensorInfo {
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   bool has_pose = false;
   std::int64_t last_ns = std::numeric_limits<std::int64_t>::min();
+  // Its clock against ours: the least (arrival - stamp) over the current and
+  // the previous window of kShiftWindow, i.e. the shift that makes its
+  // quickest delivery lately take no time. Stamp + shift is the capture time
+  // on our clock, late by at most that quickest delivery (a hop: well under a
+  // millisecond on a LAN); the windows follow a drifting clock.
+  std::int64_t shift_now = std::numeric_limits<std::int64_t>::max();
+  std::int64_t shift_before = std::numeric_limits<std::int64_t>::max();
+  std::int64_t shift_window_ns = std::numeric_limits<std::int64_t>::min();
+  std::int64_t capture_latency_ns = 0;  // the tracker's own delay: its skeleton shows the body this long before its stamp
+  std::int64_t capture_ns(std::int64_t stamp_ns) const {
+    const auto shift = std::min(shift_now, shift_before);
+    return (shift == std::numeric_limits<std::int64_t>::max() ? stamp_ns : stamp_ns + shift) - capture_latency_ns;
+  }
 };
+constexpr std::int64_t kShiftWindow = 10'000'000'000;
 
 struct View {
   Stream* stream;
@@ -133,6 +147,7 @@ struct Fuser::Impl {
       if (sensors[i].id == id) return i;
     }
     sensors.push_back({id});
+    sensors.back().capture_latency_ns = opt.capture_latency_ns;
     return sensors.size() - 1;
   }
 
@@ -151,6 +166,7 @@ struct Fuser::Impl {
     if (!opt.interpolate || after == nullptr || before->t == t) return before->world;
     const double a = static_cast<double>(t - before->t) / static_cast<double>(after->t - before->t);
     skeleton::Skeleton s = before->world;
+    s.stamp_ns = before->world.stamp_ns + std::llround(a * static_cast<double>(after->world.stamp_ns - before->world.stamp_ns));
     for (std::size_t j = 0; j < kJointCount; ++j) {
       const auto& b = before->world.joints[j];
       const auto& c = after->world.joints[j];
@@ -623,6 +639,16 @@ struct Fuser::Impl {
           }
         }
       }
+      // Capture stamps of what it was made from (views left out as ghosts aside).
+      for (const bool all : {false, true}) {
+        for (const auto& v : vs) {
+          if (v->occluded && !all) continue;
+          const auto c = sensors[v->sensor].capture_ns(v->s.stamp_ns);
+          f.capture_oldest_ns = f.capture_oldest_ns == 0 ? c : std::min(f.capture_oldest_ns, c);
+          f.capture_newest_ns = f.capture_newest_ns == 0 ? c : std::max(f.capture_newest_ns, c);
+        }
+        if (f.capture_oldest_ns != 0) break;
+      }
       if (const auto c = skeleton::centre_of(f)) tr.centre = *c;
       tr.last_ns = t;
       tr.last = f;
@@ -645,6 +671,10 @@ void Fuser::set_pose(const std::string& sensor, const Eigen::Isometry3d& world_f
   s.has_pose = true;
 }
 
+void Fuser::set_capture_latency(const std::string& sensor, std::int64_t ns) {
+  impl_->sensors[impl_->sensor_index(sensor)].capture_latency_ns = ns;
+}
+
 bool Fuser::has_pose(const std::string& sensor) const {
   return std::any_of(impl_->sensors.begin(), impl_->sensors.end(),
                      [&](const SensorInfo& s) { return s.id == sensor && s.has_pose; });
@@ -659,6 +689,13 @@ void Fuser::add(const skeleton::Skeleton& raw, std::int64_t t_ns) {
   const auto i = impl_->sensor_index(raw.sensor_id);
   auto& sensor = impl_->sensors[i];
   sensor.last_ns = std::max(sensor.last_ns, t_ns);
+  if (t_ns - sensor.shift_window_ns > kShiftWindow) {
+    sensor.shift_before = sensor.shift_now;
+    sensor.shift_now = t_ns - raw.stamp_ns;
+    sensor.shift_window_ns = t_ns;
+  } else {
+    sensor.shift_now = std::min(sensor.shift_now, t_ns - raw.stamp_ns);
+  }
   if (!sensor.has_pose) {
     ++impl_->stats.no_pose;
     return;

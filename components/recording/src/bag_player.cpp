@@ -4,6 +4,7 @@
 #include <climits>
 #include <sstream>
 
+#include "skelgraph/msg/schema.hpp"
 #include "skelgraph/runtime/ordered_queue.hpp"
 #include "skelgraph/runtime/topics.hpp"
 
@@ -53,6 +54,9 @@ BagPlayer::BagPlayer(runtime::Context& ctx, const runtime::Params& params)
     if (!selected || count == 0) continue;
     const auto type = ch.metadata.count("dds_type") ? ch.metadata.at("dds_type") : std::string();
     if (type.empty()) throw std::invalid_argument(file_ + ": channel " + ch.topic + " has no DDS type name");
+    const auto schema = summary.schemas.find(ch.schema_id);
+    if (msg::may_be_older_schema(type, schema == summary.schemas.end() ? std::string() : schema->second.data))
+      older_schema_[id] = type;
     const bool keyed = ch.metadata.count("keyed") && ch.metadata.at("keyed") == "true";
     const auto* known = runtime::find_topic(ch.topic);
     runtime::QosPreset qos = known ? known->qos : runtime::QosPreset{};
@@ -240,7 +244,11 @@ void BagPlayer::play_once(std::uint64_t from) {
     const auto it = publisher_of_channel_.find(ch.id);
     if (it == publisher_of_channel_.end()) return;
     Pending p{it->second, {}};
-    p.sample.payload.assign(m.data.begin(), m.data.end());
+    const auto older = older_schema_.find(ch.id);
+    auto upgraded = older == older_schema_.end() ? std::nullopt
+                                                 : msg::upgrade_cdr(older->second, m.data.data(), m.data.size());
+    if (upgraded) p.sample.payload = std::move(*upgraded);
+    else p.sample.payload.assign(m.data.begin(), m.data.end());
     pending.push(0, static_cast<std::int64_t>(m.log_time), std::move(p));
     pending.drain(play);
   });

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace skelgraph::runtime {
 
@@ -36,6 +37,25 @@ RateSummary RateStats::summary() const {
   s.std_period_s = std::sqrt(std::max(0.0, sum_sq / n - s.mean_period_s * s.mean_period_s));
   s.rate_hz = s.mean_period_s > 0.0 ? 1.0 / s.mean_period_s : 0.0;
   return s;
+}
+
+void Percentiles::add(double v) {
+  recent_.push_back(v);
+  if (recent_.size() > keep_) recent_.pop_front();
+  max_ = count_ == 0 ? v : std::max(max_, v);
+  ++count_;
+}
+
+double Percentiles::quantile(double q) const {
+  if (recent_.empty()) return 0.0;
+  std::vector<double> v(recent_.begin(), recent_.end());
+  const auto k = static_cast<std::size_t>(std::clamp(q, 0.0, 1.0) * static_cast<double>(v.size() - 1) + 0.5);
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+  return v[k];
+}
+
+nlohmann::json Percentiles::json() const {
+  return {{"n", count_}, {"p50", quantile(0.5)}, {"p99", quantile(0.99)}, {"max", max_}};
 }
 
 }  // namespace skelgraph::runtime

@@ -34,7 +34,16 @@ msg::Skeleton to_msg(const Skeleton& s) {
     set(o.orientation(), j.orientation);
     o.confidence(j.confidence);
     o.sensor_mask(j.sensor_mask);
+    auto& c = m.covariance()[i];
+    c.xx(j.covariance[0]);
+    c.xy(j.covariance[1]);
+    c.xz(j.covariance[2]);
+    c.yy(j.covariance[3]);
+    c.yz(j.covariance[4]);
+    c.zz(j.covariance[5]);
   }
+  m.capture_oldest_ns(s.capture_oldest_ns != 0 ? s.capture_oldest_ns : s.stamp_ns);
+  m.capture_newest_ns(s.capture_newest_ns != 0 ? s.capture_newest_ns : s.stamp_ns);
   return m;
 }
 
@@ -52,7 +61,11 @@ Skeleton from_msg(const msg::Skeleton& m) {
     j.orientation = Eigen::Quaterniond(o.orientation().w(), o.orientation().x(), o.orientation().y(), o.orientation().z());
     j.confidence = o.confidence();
     j.sensor_mask = o.sensor_mask();
+    const auto& c = m.covariance()[i];
+    j.covariance = {c.xx(), c.xy(), c.xz(), c.yy(), c.yz(), c.zz()};
   }
+  s.capture_oldest_ns = m.capture_oldest_ns();
+  s.capture_newest_ns = m.capture_newest_ns();
   return s;
 }
 

@@ -53,6 +53,7 @@ window.addEventListener('resize', resize);
 resize();
 
 const jointGeometry = new THREE.SphereGeometry(0.035, 12, 8);
+const unitSphere = new THREE.SphereGeometry(1, 16, 12);
 const colours = new Map();  // stream -> colour
 function colourOf(stream) {
   if (FIXED_COLOURS[stream] !== undefined) return FIXED_COLOURS[stream];
@@ -86,6 +87,7 @@ function layer(name, label, colour) {
 }
 layer('sensors', 'sensors and frustums', 0x9aa5b1);
 layer('gestures', 'gestures', 0xff4040);
+layer('uncertainty', 'uncertainty (95 % spheres)', 0xc0c0c0);
 
 // --- skeletons ------------------------------------------------------------
 const skeletons = new Map();  // "stream/person" -> drawn objects
@@ -101,6 +103,17 @@ function makeSkeleton(stream, kind) {
     group.add(m);
     joints.push(m);
   }
+  // Each joint's 95 % region (fused skeletons that carry a covariance), translucent.
+  const uncertainty = new THREE.Group();
+  const shell = new THREE.MeshBasicMaterial({ color: colour, transparent: true, opacity: 0.15, depthWrite: false });
+  const spheres = [];
+  for (let i = 0; i < 15; i++) {
+    const m = new THREE.Mesh(unitSphere, shell);
+    m.visible = false;
+    uncertainty.add(m);
+    spheres.push(m);
+  }
+  group.add(uncertainty);
   const bonePositions = new Float32Array(BONES.length * 6);
   const boneGeometry = new THREE.BufferGeometry();
   boneGeometry.setAttribute('position', new THREE.BufferAttribute(bonePositions, 3));
@@ -108,7 +121,7 @@ function makeSkeleton(stream, kind) {
     color: colour, transparent: kind === 'truth', opacity: kind === 'truth' ? 0.6 : 1 }));
   group.add(bones);
   scene.add(group);
-  return { group, joints, bones, bonePositions, tracked, inferred, stream };
+  return { group, joints, bones, bonePositions, tracked, inferred, stream, uncertainty, spheres };
 }
 
 function drawSkeleton(s) {
@@ -120,6 +133,12 @@ function drawSkeleton(s) {
   s.joints.forEach((j, i) => {
     const m = d.joints[i];
     m.visible = j[3] > 0;
+    const u = d.spheres[i];
+    u.visible = m.visible && j[4] > 0;
+    if (u.visible) {
+      u.position.set(j[0], j[1], j[2]);
+      u.scale.setScalar(j[4]);
+    }
     if (!m.visible) return;
     m.position.set(j[0], j[1], j[2]);
     m.material = j[3] === 2 ? d.tracked : d.inferred;
@@ -302,7 +321,10 @@ function count() {
     if (!d.group.visible) continue;
     const n = d.joints.filter((m) => m.visible).length;
     joints += n;
-    list.push({ stream: d.info.stream, kind: d.info.kind, person: d.info.person, frame: d.info.frame, joints: n });
+    const spheres = d.uncertainty.visible ? d.spheres.filter((m) => m.visible) : [];
+    list.push({ stream: d.info.stream, kind: d.info.kind, person: d.info.person, frame: d.info.frame, joints: n,
+                uncertainty: spheres.length,
+                radius_95_max: spheres.reduce((r, m) => Math.max(r, m.scale.x), 0) });
   }
   stats.drawn = { skeletons: list.length, joints, list };
 }
@@ -318,7 +340,10 @@ function render(now) {
     drawnTimes.push(now);
   }
   if (dirty) {
-    for (const d of skeletons.values()) d.group.visible = layers.get(d.info.stream)?.visible ?? true;
+    for (const d of skeletons.values()) {
+      d.group.visible = layers.get(d.info.stream)?.visible ?? true;
+      d.uncertainty.visible = layers.get('uncertainty').visible;
+    }
     for (const g of sensors.values()) g.visible = layers.get('sensors').visible;
     gestureGroup.visible = layers.get('gestures').visible;
     count();

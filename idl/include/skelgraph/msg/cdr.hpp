@@ -41,4 +41,8 @@ T from_cdr(const void* data, std::size_t size) {
   return value;
 }
 
+// Skeletons of every schema (schema.hpp): older ones are read as the current type.
+template <>
+Skeleton from_cdr<Skeleton>(const void* data, std::size_t size);
+
 }  // namespace skelgraph::msg

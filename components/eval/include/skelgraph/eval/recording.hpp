@@ -63,6 +63,8 @@ void stream_recording(const RecordingInputs& in, Evaluator& ev, const MessageHoo
 struct RecordingOptions {
   std::vector<std::string> methods;  // fusion methods by name; empty: all
   double delay_ms = 0, max_age_ms = 100;
+  double predict_ms = 0;    // kalman: predicted this far past each fusion time
+  double use_delay_ms = 0;  // scored against the truth this long after each output (the time of use)
   bool shared_frame = false;
   std::string calibration;  // a calibration file's poses instead of the recording's
 };

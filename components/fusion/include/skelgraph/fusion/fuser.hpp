@@ -55,6 +55,8 @@ struct FuserOptions {
   // and covariance carried forward): the trackers' own delay plus the
   // consumer's, so the skeleton says where the person is when it is used.
   std::int64_t predict_ns = 0;
+  // Every sensor's tracker delay unless set_capture_latency says otherwise.
+  std::int64_t capture_latency_ns = 0;
 };
 
 struct FuserStats {
@@ -78,6 +80,9 @@ class Fuser {
   // sensor without a pose are counted and ignored.
   void set_pose(const std::string& sensor, const Eigen::Isometry3d& world_from_sensor);
   bool has_pose(const std::string& sensor) const;
+  // The sensor's tracker delay: its skeletons show the body this long before
+  // their stamps (NITE about 50 ms). Only the capture stamps use it.
+  void set_capture_latency(const std::string& sensor, std::int64_t ns);
 
   // The sensor delivered a frame at t_ns (whether or not it saw anyone): it is alive.
   void heartbeat(const std::string& sensor, std::int64_t t_ns);
@@ -96,7 +101,11 @@ class Fuser {
 
   // The fused skeleton of every person seen at t_ns (minus delay): world
   // frame, sensor_id "fused", stable person ids, joint sensor_mask bit i =
-  // sensors()[i] contributed. Call with non-decreasing times.
+  // sensors()[i] contributed, capture_oldest/newest_ns when the sensors'
+  // skeletons it was made from were captured, on the caller's clock: each
+  // sensor's stamps shifted by the least (arrival - stamp) seen lately (its
+  // clock need not be ours), minus its capture latency; an interpolated
+  // view's stamp interpolated alike. Call with non-decreasing times.
   std::vector<skeleton::Skeleton> fuse(std::int64_t t_ns);
 
   // Every sensor seen so far, in mask-bit order.

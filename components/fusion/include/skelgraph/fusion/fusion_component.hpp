@@ -15,9 +15,11 @@
 #include <set>
 #include <string>
 
+#include "skelgraph/fusion/arrival_gate.hpp"
 #include "skelgraph/fusion/fuser.hpp"
 #include "skelgraph/runtime/component.hpp"
 #include "skelgraph/runtime/pubsub.hpp"
+#include "skelgraph/runtime/rate_stats.hpp"
 
 namespace skelgraph::fusion {
 
@@ -31,13 +33,19 @@ class FusionComponent final : public runtime::Component {
 
  private:
   void step(std::int64_t now_ns);
+  void fuse_if_ready(std::int64_t now_ns);
   void update_health(std::int64_t now_ns);
 
   Fuser fuser_;
   std::string output_id_;
   std::int64_t period_ns_;
-  bool on_ticks_;
+  std::string trigger_;            // ticks, timer or arrival
+  ArrivalGate gate_;
+  runtime::TimerHandle wait_timer_;  // arrival: ends the wait for the other sensors
+  bool wait_armed_ = false;
   std::int64_t last_tick_ns_ = 0;  // when the last sync TICK drove a step
+  std::int64_t last_step_ns_ = 0;
+  runtime::Percentiles compute_;   // fuse() per step, microseconds
   std::uint64_t steps_ = 0, published_ = 0, tick_steps_ = 0, departed_ = 0;
   std::set<std::string> silent_;
   std::uint64_t dropouts_ = 0, rejoins_ = 0;

@@ -75,6 +75,7 @@ class BagPlayer final : public runtime::Component {
   std::uint64_t first_log_time_ = 0;
   std::uint64_t per_pass_ = 0;  // messages selected for playback in one pass
   std::map<std::uint16_t, std::size_t> publisher_of_channel_;  // channel id -> index in publishers_
+  std::map<std::uint16_t, std::string> older_schema_;  // channels that may hold an older schema: their type
   std::vector<std::unique_ptr<runtime::RawPublisher>> publishers_;
   std::vector<std::string> publisher_topics_;
   std::vector<bool> publisher_is_state_;  // transient-local topics: replayed up to a seek's position

@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <deque>
 
+#include <nlohmann/json.hpp>
+
 namespace skelgraph::runtime {
 
 struct RateSummary {
@@ -31,6 +33,26 @@ class RateStats {
   std::int64_t window_ns_;
   std::deque<std::int64_t> times_;
   std::uint64_t total_ = 0;
+};
+
+// Percentiles of a measured quantity (e.g. compute time per step): the
+// latest `keep` values, plus the count and the maximum of all of them.
+class Percentiles {
+ public:
+  explicit Percentiles(std::size_t keep = 4096) : keep_(keep) {}
+  void add(double v);
+  std::uint64_t count() const { return count_; }
+  double max() const { return max_; }
+  // q in [0, 1] over the values kept (nearest rank); 0 when empty.
+  double quantile(double q) const;
+  // {"n", "p50", "p99", "max"}
+  nlohmann::json json() const;
+
+ private:
+  std::size_t keep_;
+  std::deque<double> recent_;
+  std::uint64_t count_ = 0;
+  double max_ = 0.0;
 };
 
 }  // namespace skelgraph::runtime

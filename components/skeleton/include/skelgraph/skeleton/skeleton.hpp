@@ -69,6 +69,9 @@ struct Skeleton {
   std::int64_t stamp_ns = 0;       // on the source's clock
   std::uint64_t frame_number = 0;
   std::array<Joint, kJointCount> joints{};
+  // Capture stamps of the inputs it was made from (fused output; a raw
+  // skeleton's are its stamp_ns). 0: not given, take stamp_ns.
+  std::int64_t capture_oldest_ns = 0, capture_newest_ns = 0;
 
   Joint& operator[](JointId id) { return joints[static_cast<std::size_t>(id)]; }
   const Joint& operator[](JointId id) const { return joints[static_cast<std::size_t>(id)]; }

@@ -29,6 +29,8 @@ StreamKind stream_kind(const std::string& sensor_id);
 
 // 2 tracked (confidence >= 0.75), 1 inferred (> 0), 0 lost.
 int joint_state(float confidence);
+// The radius of the sphere round a joint's 95 % region (m); 0 without a covariance.
+double radius_95(const skeleton::Joint& j);
 
 struct SceneOptions {
   std::int64_t max_age_ns = 500'000'000;       // skeletons older than this are not drawn
@@ -54,6 +56,7 @@ class Scene {
   void on_player(const std::string& player, nlohmann::json state);
 
   // The frame message: {"type":"frame", "seq", "skeletons": [...], "sensors": [...],
+  // (each skeleton's joints [x, y, z, state, radius_95], m; state 0: not drawn)
   // "streams": {...}, "gestures": [...], "status": [...], "players": [...], "unplaced": [...]}.
   // Drops what has aged out as of now_ns.
   nlohmann::json frame(std::int64_t now_ns);
