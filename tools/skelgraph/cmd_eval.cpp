@@ -117,6 +117,25 @@ std::string report_section(const std::string& dir, const std::string& name, cons
   write_text_file(std::filesystem::path(dir) / (name + ".csv"), csv_header() + csv_rows(name, r));
   h << "<p>This table as CSV: <a href=\"" << report::html_escape(name) << ".csv\">" << report::html_escape(name)
     << ".csv</a></p>\n";
+  // Reliability of the published uncertainty: nominal level against the share of truth inside it.
+  std::vector<report::Series> reliability;
+  for (const auto& s : r.streams) {
+    const auto curve = s.uncertainty.reliability();
+    if (curve.empty()) continue;
+    if (reliability.empty()) reliability.push_back({"ideal", {0, 100}, {0, 100}});
+    report::Series se{s.name, {}, {}};
+    for (const auto& [nominal, observed] : curve) {
+      se.x.push_back(nominal);
+      se.y.push_back(observed);
+    }
+    reliability.push_back(std::move(se));
+  }
+  if (!reliability.empty()) {
+    const auto svg = report::line_plot(title + ": truth inside the published region (reliability)",
+                                       "nominal level (%)", "truth inside (%)", reliability, 420, 320);
+    write_text_file(std::filesystem::path(dir) / (name + "_reliability.svg"), svg);
+    h << "<figure>" << svg << "<figcaption>" << report::html_escape(name) << "_reliability.svg</figcaption></figure>\n";
+  }
   if (r.streams.empty() || r.streams.front().trace.empty()) return h.str();
   const double t0 = static_cast<double>(r.streams.front().trace.front().t_ns);
   const auto secs = [&](const eval::StreamScore& s) {

@@ -202,6 +202,10 @@ double Steadiness::mean_bone_sd_cm() const {
 namespace {
 constexpr std::size_t kKeptForSpearman = 200000;
 constexpr double kChi2Of3At95 = 7.8147;
+// Nominal levels (%) and their chi-square(3) quantiles.
+constexpr std::pair<double, double> kReliabilityLevels[] = {{10, 0.5844}, {20, 1.0052}, {30, 1.4237}, {40, 1.8692},
+                                                            {50, 2.3660}, {60, 2.9462}, {70, 3.6649}, {80, 4.6416},
+                                                            {90, 6.2514}, {95, 7.8147}, {99, 11.3449}};
 
 std::vector<double> ranks(std::vector<double> v) {
   std::vector<std::size_t> order(v.size());
@@ -243,7 +247,11 @@ void UncertaintyCheck::add(const skeleton::Skeleton& estimate, const skeleton::S
     if (llt.info() != Eigen::Success) continue;  // not a covariance
     const Eigen::Vector3d d = e.position - truth.joints[j].position;
     ++n_;
-    if (d.dot(llt.solve(d)) <= kChi2Of3At95) ++inside_;
+    const double m2 = d.dot(llt.solve(d));
+    if (m2 <= kChi2Of3At95) ++inside_;
+    for (std::size_t k = 0; k < kLevels; ++k) {
+      if (m2 <= kReliabilityLevels[k].second) ++inside_level_[k];
+    }
     const std::pair<double, double> sample{std::sqrt(c.trace() / 3.0), d.norm()};
     if (kept_.size() < kKeptForSpearman) {
       kept_.push_back(sample);
@@ -257,6 +265,16 @@ void UncertaintyCheck::add(const skeleton::Skeleton& estimate, const skeleton::S
 
 double UncertaintyCheck::inside_95_pct() const {
   return n_ > 0 ? 100.0 * static_cast<double>(inside_) / static_cast<double>(n_) : std::nan("");
+}
+
+std::vector<std::pair<double, double>> UncertaintyCheck::reliability() const {
+  static_assert(std::size(kReliabilityLevels) == kLevels);
+  std::vector<std::pair<double, double>> out;
+  if (n_ == 0) return out;
+  for (std::size_t k = 0; k < kLevels; ++k) {
+    out.emplace_back(kReliabilityLevels[k].first, 100.0 * static_cast<double>(inside_level_[k]) / static_cast<double>(n_));
+  }
+  return out;
 }
 
 double UncertaintyCheck::sigma_error_spearman() const { return spearman(kept_); }

@@ -55,7 +55,8 @@ nlohmann::json stream_json(const StreamScore& s) {
            {{"joint_ticks", s.uncertainty.joint_ticks()},
             {"inside_95_pct", num(s.uncertainty.inside_95_pct())},
             {"sigma_error_spearman", num(s.uncertainty.sigma_error_spearman())},
-            {"median_sigma_cm", num(s.uncertainty.median_sigma_cm())}}},
+            {"median_sigma_cm", num(s.uncertainty.median_sigma_cm())},
+            {"reliability", s.uncertainty.reliability()}}},
           {"ticks", s.ticks},
           {"ticks_with_output", s.with_output}};
 }

@@ -37,6 +37,15 @@ runtime::ComponentInfo FusionComponent::describe() {
       .add_string_list("capture_latency_ms", {},
                        "the trackers' own delay, 'SENSOR:MS' or 'MS' for every sensor (NITE: about 50): the fused "
                        "skeletons' capture stamps say when the body was where they show it")
+      .add_double("bias_sd_scale", 1.0,
+                  "kalman, weighted: scale of the trackers' joint-placement error added to the published covariance "
+                  "(1: as fitted on the simulator's NITE model; 0: the filter's and the sensors' part alone)",
+                  0.0, 10.0)
+      .add_string("sensor_clocks", "estimate",
+                  "estimate: each sensor's clock is brought onto this host's by its quickest delivery; shared: the "
+                  "sensors stamp on this host's clock (same host, or PTP), so a tracker's processing time counts in "
+                  "the age",
+                  {"estimate", "shared"})
       .add_string("output_id", "fused", "sensor_id of the fused skeletons (several fusion components: one each)");
   return info;
 }
@@ -51,6 +60,8 @@ FuserOptions options_from(const runtime::Params& p) {
   o.person_timeout_ns = static_cast<std::int64_t>(p.get<double>("person_timeout_ms") * 1e6);
   o.match_distance_m = p.get<double>("match_distance_m");
   o.predict_ns = static_cast<std::int64_t>(p.get<double>("predict_ms") * 1e6);
+  o.shared_clock = p.get<std::string>("sensor_clocks") == "shared";
+  o.bias_sd_scale = p.get<double>("bias_sd_scale");
   return o;
 }
 

@@ -60,9 +60,14 @@ class UncertaintyCheck {
   double inside_95_pct() const;     // NaN when none
   double sigma_error_spearman() const;  // NaN with fewer than 3
   double median_sigma_cm() const;   // NaN when none
+  // The reliability curve: for each nominal level (%), the joint-ticks whose
+  // truth lies inside that level's region (%). Honest: on the diagonal.
+  std::vector<std::pair<double, double>> reliability() const;
 
  private:
+  static constexpr std::size_t kLevels = 11;
   std::uint64_t n_ = 0, inside_ = 0, rng_ = 0x9e3779b97f4a7c15ULL;
+  std::array<std::uint64_t, kLevels> inside_level_{};
   std::vector<std::pair<double, double>> kept_;  // (sigma, error), m
 };
 

@@ -57,6 +57,18 @@ struct FuserOptions {
   std::int64_t predict_ns = 0;
   // Every sensor's tracker delay unless set_capture_latency says otherwise.
   std::int64_t capture_latency_ns = 0;
+  // The sensors stamp on the caller's clock (one host, or clocks kept in step
+  // by PTP): capture times are their stamps. Otherwise (the default) each
+  // sensor's clock is brought onto the caller's by its quickest delivery,
+  // which also takes any constant delay between its stamp and its delivery
+  // (a tracker's processing) for clock offset: only the varying part of that
+  // delay shows in the age.
+  bool shared_clock = false;
+  // kalman and weighted: the trackers' joint-placement error that averaging
+  // cannot remove, added to each joint's published covariance (fuser.cpp,
+  // kBiasSdM: fitted on the simulator's NITE model), times this scale; 0
+  // publishes the filter's and the sensors' part alone.
+  double bias_sd_scale = 1.0;
 };
 
 struct FuserStats {
