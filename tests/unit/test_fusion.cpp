@@ -649,6 +649,35 @@ TEST(Fusion, KalmanPublishesEachJointsUncertainty) {
   EXPECT_GT(h.sigma_error_spearman(), 0.5);  // measured 0.62
 }
 
+// Scored two ways: at each output's own time, and (use_delay_ns) against
+// where the person is that much later; in a walk every stream is further
+// off then, and without a delay nothing is scored at use.
+TEST(Evaluation, EveryStreamIsScoredAtItsTimeAndAtTheTimeOfUse) {
+  sim::SimConfig cfg;
+  cfg.scenario.name = "walk";
+  sim::Simulation sim(cfg);
+  std::map<std::string, Eigen::Isometry3d> poses;
+  for (const auto& s : cfg.sensors) poses[s.id] = s.world_from_sensor();
+  std::vector<eval::TimedSkeleton> events;
+  for (auto& e : sim.advance(sim.duration() + 1)) {
+    events.push_back({e.kind == sim::SimEvent::Kind::Truth ? eval::TimedSkeleton::Kind::Truth : eval::TimedSkeleton::Kind::Raw,
+                      static_cast<std::int64_t>(std::llround(e.t * 1e9)), std::move(e.skeleton)});
+  }
+  eval::OfflineOptions o;
+  o.methods = {fusion::Method::Kalman};
+  const auto now = eval::evaluate(poses, events, o);
+  o.use_delay_ns = 300 * kMs;
+  const auto later = eval::evaluate(poses, events, o);
+  ASSERT_EQ(now.streams.size(), later.streams.size());
+  for (std::size_t i = 0; i < now.streams.size(); ++i) {
+    const auto& a = now.streams[i];
+    const auto& b = later.streams[i];
+    EXPECT_TRUE(std::isnan(a.at_use.mean_error_cm())) << a.name;
+    EXPECT_DOUBLE_EQ(a.accuracy.mean_error_cm(), b.accuracy.mean_error_cm()) << a.name;  // at its own time: unchanged
+    EXPECT_GT(b.at_use.mean_error_cm(), b.accuracy.mean_error_cm() + 0.5) << a.name;     // the person walked on
+  }
+}
+
 TEST(Evaluation, ConstantBodyFrameOffsetsAreLearntAndRemoved) {
   std::vector<eval::TimedSkeleton> events;
   for (int k = 0; k < 600; ++k) {  // 20 s at 30 Hz, turning at 18 degrees per second

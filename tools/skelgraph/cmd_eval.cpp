@@ -43,17 +43,27 @@ namespace skelgraph::cli {
 namespace {
 
 
+// Scored at the time of use too (eval --use-delay-ms): the tables get a column.
+bool has_at_use(const eval::OfflineResult& r) {
+  return std::any_of(r.streams.begin(), r.streams.end(), [](const eval::StreamScore& s) {
+    return std::isfinite(s.at_use.mean_error_cm());
+  });
+}
+
 void print_table(const std::string& title, const eval::OfflineResult& r) {
+  const bool at_use = has_at_use(r);
   std::printf("\n### %s\n\n| stream |", title.c_str());
   for (const auto* g : eval::group_names()) std::printf(" %s det %% | %s err cm |", g, g);
-  std::printf(" mean err cm | offsets removed cm | upper body %% | bone SD cm |\n|---|");
+  std::printf(" mean err cm |%s offsets removed cm | upper body %% | bone SD cm |\n|---|", at_use ? " at use cm |" : "");
   for (std::size_t g = 0; g < eval::kGroupCount; ++g) std::printf("---:|---:|");
-  std::printf("---:|---:|---:|---:|\n");
+  std::printf("---:|%s---:|---:|---:|\n", at_use ? "---:|" : "");
   for (const auto& s : r.streams) {
     std::printf("| %s |", s.name.c_str());
     for (const auto& g : s.accuracy.figures()) std::printf(" %.1f | %.1f |", g.detection_pct, g.error_cm);
-    std::printf(" %.1f | %.1f | %.1f | %.2f |\n", s.accuracy.mean_error_cm(), s.compensated.mean_error_cm(),
-                s.steadiness.upper_body_complete_pct(), s.steadiness.mean_bone_sd_cm());
+    std::printf(" %.1f |", s.accuracy.mean_error_cm());
+    if (at_use) std::printf(" %.1f |", s.at_use.mean_error_cm());
+    std::printf(" %.1f | %.1f | %.2f |\n", s.compensated.mean_error_cm(), s.steadiness.upper_body_complete_pct(),
+                s.steadiness.mean_bone_sd_cm());
   }
 }
 
@@ -74,7 +84,7 @@ std::string csv_num(double v, int decimals) {
 std::string csv_header() {
   std::string h = "scenario,stream,fused";
   for (const auto* g : eval::group_names()) h += std::string(",") + g + "_detection_pct," + g + "_error_cm";
-  return h + ",mean_error_cm,offsets_removed_error_cm,upper_body_complete_pct,bone_length_sd_cm,ticks\n";
+  return h + ",mean_error_cm,offsets_removed_error_cm,upper_body_complete_pct,bone_length_sd_cm,ticks,at_use_mean_error_cm\n";
 }
 std::string csv_rows(const std::string& scenario, const eval::OfflineResult& r) {
   std::string out;
@@ -83,7 +93,7 @@ std::string csv_rows(const std::string& scenario, const eval::OfflineResult& r) 
     for (const auto& g : s.accuracy.figures()) out += "," + csv_num(g.detection_pct, 2) + "," + csv_num(g.error_cm, 3);
     out += "," + csv_num(s.accuracy.mean_error_cm(), 3) + "," + csv_num(s.compensated.mean_error_cm(), 3) + "," +
            csv_num(s.steadiness.upper_body_complete_pct(), 2) + "," + csv_num(s.steadiness.mean_bone_sd_cm(), 3) + "," +
-           std::to_string(s.ticks) + "\n";
+           std::to_string(s.ticks) + "," + csv_num(s.at_use.mean_error_cm(), 3) + "\n";
   }
   return out;
 }
@@ -101,7 +111,9 @@ std::string report_section(const std::string& dir, const std::string& name, cons
   std::ostringstream h;
   h << "<h2>" << report::html_escape(title) << "</h2>\n<table><tr><th>stream</th>";
   for (const auto* g : eval::group_names()) h << "<th>" << g << " det %</th><th>" << g << " err cm</th>";
-  h << "<th>mean err cm</th><th>offsets removed cm</th><th>upper body %</th><th>bone SD cm</th></tr>\n";
+  const bool at_use = has_at_use(r);
+  h << "<th>mean err cm</th>" << (at_use ? "<th>at use cm</th>" : "")
+    << "<th>offsets removed cm</th><th>upper body %</th><th>bone SD cm</th></tr>\n";
   for (const auto& s : r.streams) {
     // (Cells built as strings: a fixed buffer once cut the row's end off when figures had more digits.)
     const auto td = [](double v, int decimals) {
@@ -110,7 +122,9 @@ std::string report_section(const std::string& dir, const std::string& name, cons
     };
     h << "<tr><td>" << report::html_escape(s.name) << "</td>";
     for (const auto& g : s.accuracy.figures()) h << td(g.detection_pct, 1) << td(g.error_cm, 1);
-    h << "<td><b>" << csv_num(s.accuracy.mean_error_cm(), 1) << "</b></td>" << td(s.compensated.mean_error_cm(), 1)
+    h << "<td><b>" << csv_num(s.accuracy.mean_error_cm(), 1) << "</b></td>";
+    if (at_use) h << td(s.at_use.mean_error_cm(), 1);
+    h << td(s.compensated.mean_error_cm(), 1)
       << td(s.steadiness.upper_body_complete_pct(), 1) << td(s.steadiness.mean_bone_sd_cm(), 2) << "</tr>\n";
   }
   h << "</table>\n";
@@ -392,6 +406,11 @@ int eval_sim(const SimEvalOptions& o) {
                 "ticks. 'Offsets removed': after the first 5 s, each stream's constant per-joint offsets (learnt in its own "
                 "body frame over those 5 s) subtracted. Fusion delay %.0f ms, max sample age %.0f ms.\n",
                 o.delay_ms, o.max_age_ms);
+    if (o.use_delay_ms > 0) {
+      std::printf("'At use': the mean error against where the person is %.0f ms after each output (kalman predicting "
+                  "%.0f ms).\n",
+                  o.use_delay_ms, o.predict_ms);
+    }
   }
   for (const auto& scenario : o.scenarios) {
     const sim::SimConfig cfg = sim_config(o.params, "eval sim", {{"scenario", scenario, "--scenarios"}});

@@ -178,7 +178,8 @@ struct Evaluator::Impl {
     ++result.ticks;
     const std::int64_t at = tick - options.fuser.delay_ns;
     truth.forget_before(at - 1'000'000'000);
-    const bool truth_here = truth.covers(at + options.use_delay_ns);
+    const bool truth_here = truth.covers(at);
+    const bool truth_at_use = options.use_delay_ns > 0 && truth.covers(at + options.use_delay_ns);
     std::vector<bool> complete(lanes.size(), false);  // a skeleton of the lane has the whole upper body at confidence 1
     for (std::size_t i = 0; i < lanes.size(); ++i) {
       auto& lane = lanes[i];
@@ -205,8 +206,9 @@ struct Evaluator::Impl {
         lane.score.steadiness.add(f);
         complete[i] = complete[i] || upper_body_complete(f);
       }
+      if (truth_at_use) score_at_use(lane, fused, at + options.use_delay_ns);
       if (!truth_here) continue;
-      score(lane, fused, at + options.use_delay_ns);
+      score(lane, fused, at);
     }
     bool any_single = false;
     for (std::size_t i = 0; i < lanes.size(); ++i) any_single = any_single || (lanes[i].kind == Lane::Kind::Single && complete[i]);
@@ -219,6 +221,16 @@ struct Evaluator::Impl {
 
   // Each true person is scored against the fused person nearest it; a
   // person nobody reports is a missed frame.
+  // At the time of use: each output against where its person is then (the truth nearest it).
+  void score_at_use(Lane& lane, const std::vector<skeleton::Skeleton>& fused, std::int64_t at) {
+    for (const auto& f : fused) {
+      const auto c = skeleton::centre_of(f);
+      const auto t = c ? truth.at(at, *c) : std::nullopt;
+      if (!t || ((*t)[skeleton::JointId::Torso].position - *c).norm() > 1.0) continue;  // a ghost
+      lane.score.at_use.add(f, *t);
+    }
+  }
+
   void score(Lane& lane, const std::vector<skeleton::Skeleton>& fused, std::int64_t at) {
     bool scored = false;
     TracePoint tp;

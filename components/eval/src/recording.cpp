@@ -46,6 +46,8 @@ nlohmann::json stream_json(const StreamScore& s) {
           {"groups", groups},
           {"mean_error_cm", num(s.accuracy.mean_error_cm())},
           {"mean_group_error_cm", num(s.accuracy.mean_group_error_cm())},
+          {"at_use_mean_error_cm", num(s.at_use.mean_error_cm())},
+          {"at_use_mean_group_error_cm", num(s.at_use.mean_group_error_cm())},
           {"after_calibration_mean_error_cm", num(s.after_calibration.mean_error_cm())},
           {"compensated_mean_error_cm", num(s.compensated.mean_error_cm())},
           {"upper_body_complete_pct", s.steadiness.upper_body_complete_pct()},

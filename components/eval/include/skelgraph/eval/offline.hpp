@@ -44,9 +44,10 @@ struct OfflineOptions {
   // `compensation_s` of truth and removed afterwards (StreamScore::compensated).
   double compensation_s = 5.0;
   skeleton::JointId trace_joint = skeleton::JointId::RightHand;
-  // Every stream scored against the truth this long after each output's
-  // time: where the person is when a consumer uses it (0: at the output's
-  // own time). At most 1 s (the evaluation holds 2 s of truth ahead).
+  // Every stream also scored against the truth this long after each
+  // output's time (StreamScore::at_use): where the person is when a consumer
+  // uses it. 0: not scored so. At most 1 s (the evaluation holds 2 s of
+  // truth ahead).
   std::int64_t use_delay_ns = 0;
 };
 
@@ -61,7 +62,8 @@ struct TracePoint {
 struct StreamScore {
   std::string name;      // a sensor id, or a method name
   bool fused = false;
-  Accumulator accuracy;  // against truth (empty without truth)
+  Accumulator accuracy;  // against truth at the output's own time (empty without truth)
+  Accumulator at_use;    // against truth OfflineOptions::use_delay_ns later (empty when 0)
   Accumulator after_calibration;  // the same ticks as `compensated`, offsets kept (the fair comparison)
   Accumulator compensated;        // after the calibration segment, with per-joint offsets removed
   Steadiness steadiness;
