@@ -15,6 +15,8 @@ assert os.path.getsize(d["report"]) > 10000, d["report"]
 html = open(d["report"]).read()
 for s in ("walk", "360", "hide", "box", "occ", "sit", "arms"):
     assert "<h2>%s (2 sensors" % s in html, s
+    assert "<h2>%s (4 sensors" % s in html, s  # the 4-sensor ring's section
+assert "<h1>Layout quarters:2</h1>" in html and "<h1>Layout ring:4</h1>" in html
 assert "<h2>live graph" in html
 assert "<h2>Pointing" in html
 p = d["pointing"]

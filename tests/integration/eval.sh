@@ -54,11 +54,12 @@ class Rows(HTMLParser):
             self.rows.append(self.cells); self.open = False
 rows = Rows(); rows.feed(html)
 assert rows.rows and all(n == 17 for n in rows.rows) and not rows.open, rows.rows
-# 16 figures per scenario: mean error, each group's error (6), right hand x/y/z,
-# each group's detection timeline (6)
-assert html.count("<svg") == 32 and "<table>" in html, html.count("<svg")
+# 17 figures per scenario: the uncertainty's reliability, mean error, each
+# group's error (6), right hand x/y/z, each group's detection timeline (6)
+assert html.count("<svg") == 34 and "<table>" in html, html.count("<svg")
+assert html.count("truth inside the published region (reliability)") >= 2
 svgs = [f for f in os.listdir(rep) if f.endswith(".svg")]
-assert len(svgs) == 32, svgs
+assert len(svgs) == 34 and os.path.exists(os.path.join(rep, "arms_reliability.svg")), svgs
 assert os.path.exists(os.path.join(rep, "360_error_shoulders.svg")) and os.path.exists(os.path.join(rep, "arms_torso_detected.svg"))
 for f in svgs:
     root = ET.parse(os.path.join(rep, f)).getroot()   # well-formed

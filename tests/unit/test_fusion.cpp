@@ -758,6 +758,29 @@ TEST(Evaluation, EventsOutOfOrderAndLateSensorsAreHandled) {
   EXPECT_EQ(r.streams[1].ticks, r.ticks);
 }
 
+// Identity: a recorded fused stream that gives the one true person id 5,
+// then 6, then 6 again, then 5 has switched twice in its 3 s.
+TEST(Evaluation, IdSwitchesAreCountedAgainstTheTruePerson) {
+  eval::OfflineOptions o;
+  o.methods = {};
+  o.singles = false;
+  eval::Evaluator ev({{"s1", Eigen::Isometry3d::Identity()}}, {"s1"}, {"fused"}, o);
+  for (std::int64_t k = 0; k <= 90; ++k) {
+    const std::int64_t t = 1'000'000'000 + k * 33'333'333;
+    auto truth = person("truth", 1, {0, 1, 0});
+    ev.add({eval::TimedSkeleton::Kind::Truth, t, truth});
+    ev.add({eval::TimedSkeleton::Kind::Raw, t + 1, person("s1", 1, {0, 1, 0})});
+    const std::uint32_t id = k < 30 ? 5 : (k < 75 ? 6 : 5);
+    ev.add({eval::TimedSkeleton::Kind::Fused, t + 2, person("fused", id, {0.02, 1, 0})});
+  }
+  const auto r = ev.finish();
+  ASSERT_EQ(r.streams.size(), 1u);
+  EXPECT_EQ(r.streams[0].name, "live fused");
+  EXPECT_EQ(r.streams[0].id_switches, 2u);
+  EXPECT_NEAR(r.streams[0].person_seconds, 3.0, 0.1);
+  EXPECT_NEAR(r.streams[0].id_switches_per_person_minute(), 40.0, 2.0);
+}
+
 TEST(ArrivalGate, FusesWhenEverySensorsFrameIsWholeInEitherOrder) {
   using Ready = fusion::ArrivalGate::Ready;
   fusion::ArrivalGate g(10 * kMs);

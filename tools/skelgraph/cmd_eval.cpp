@@ -412,8 +412,27 @@ int eval_sim(const SimEvalOptions& o) {
                   o.use_delay_ms, o.predict_ms);
     }
   }
+  // Each layout (--layouts LAYOUT:N, else the -p parameters alone) with every scenario.
+  std::vector<std::string> layouts = o.layouts.empty() ? std::vector<std::string>{""} : o.layouts;
+  for (const auto& layout : layouts) {
+  std::vector<std::string> params = o.params;
+  std::string prefix;  // of section titles, file names and CSV scenario labels
+  if (!layout.empty()) {
+    const auto colon = layout.find(':');
+    if (colon == std::string::npos) throw UsageError("--layouts: '" + layout + "' is not LAYOUT:SENSORS, e.g. ring:4");
+    params.erase(std::remove_if(params.begin(), params.end(),
+                                [](const std::string& a) { return a.rfind("layout=", 0) == 0 || a.rfind("sensor_count=", 0) == 0; }),
+                 params.end());  // (the layout's own take their place)
+    params.push_back("layout=" + layout.substr(0, colon));
+    params.push_back("sensor_count=" + layout.substr(colon + 1));
+    prefix = layout.substr(0, colon) + "_" + layout.substr(colon + 1) + "_";
+    const auto check = sim_config(params, "eval sim --layouts", {});
+    (void)check;  // (a bad layout or count is a usage error before anything runs)
+    if (!o.json && !o.quiet) std::printf("\n## Layout %s: %zu sensors\n", layout.substr(0, colon).c_str(), check.sensors.size());
+    if (eo.trace) html += "<h1>Layout " + report::html_escape(layout) + "</h1>\n";
+  }
   for (const auto& scenario : o.scenarios) {
-    const sim::SimConfig cfg = sim_config(o.params, "eval sim", {{"scenario", scenario, "--scenarios"}});
+    const sim::SimConfig cfg = sim_config(params, "eval sim", {{"scenario", scenario, "--scenarios"}});
     std::map<std::string, Eigen::Isometry3d> poses;
     for (const auto& s : cfg.sensors) poses[s.id] = s.world_from_sensor();
     std::vector<eval::TimedSkeleton> events;
@@ -470,6 +489,7 @@ int eval_sim(const SimEvalOptions& o) {
     for (const auto& s : r.streams) streams.push_back(eval::stream_json(s));
     out.push_back({{"scenario", scenario}, {"sensors", cfg.sensors.size()}, {"profile", cfg.profile},
                    {"seed", cfg.scenario.seed}, {"ticks", r.ticks}, {"streams", streams}, {"source", o.source}});
+    if (!layout.empty()) out.back()["layout"] = layout;
     if (!depth_info.is_null()) out.back()["depth"] = depth_info;
     const std::string title =
         scenario + " (" + std::to_string(cfg.sensors.size()) + " sensors, " +
@@ -480,9 +500,17 @@ int eval_sim(const SimEvalOptions& o) {
                   static_cast<unsigned long long>(depth_info["frames"].get<std::uint64_t>()),
                   depth_info["render_ms_per_frame"].get<double>(), depth_info["track_ms_per_frame"].get<double>());
     }
-    if (!o.json && !o.quiet) print_table(title, r);
-    if (eo.trace) html += report_section(o.report_dir, scenario, title, r, "right_hand");
-    csv += csv_rows(scenario, r);
+    if (!o.json && !o.quiet) {
+      print_table(title, r);
+      if (cfg.scenario.people > 1) {  // several people: did each keep their id?
+        std::printf("\nId switches per person-minute (a true person's output changing id):");
+        for (const auto& s : r.streams) std::printf(" %s %.2f;", s.name.c_str(), s.id_switches_per_person_minute());
+        std::printf("\n");
+      }
+    }
+    if (eo.trace) html += report_section(o.report_dir, prefix + scenario, title, r, "right_hand");
+    csv += csv_rows(prefix + scenario, r);
+  }
   }
   if (!o.csv.empty()) write_text_file(o.csv, csv);
   if (eo.trace) write_text_file(std::filesystem::path(o.report_dir) / "results.csv", csv);
@@ -551,6 +579,10 @@ void add_eval_command(CLI::App& app, GlobalOptions& g, Action& run) {
   auto* s = ev->add_subcommand("sim", "Simulated scenarios through every fusion method (no DDS, as fast as the CPU allows)");
   s->add_option("-p,--param", o->params, "simulator parameter NAME=VALUE (as the sim component's; e.g. sensor_count=2)");
   s->add_option("--scenarios", o->scenarios, "scenarios to run (default: the thesis's seven)")->delimiter(',');
+  s->add_option("--layouts", o->layouts,
+                "sensor layouts LAYOUT:SENSORS (quarters, ring, one_side, corners; e.g. quarters:2,ring:4,corners:4), each "
+                "with every scenario, a section each in the tables and the report")
+      ->delimiter(',');
   add_fusion_options(s, o->methods, o->delay_ms, o->max_age_ms, "fusion methods (default: all)");
   add_time_of_use_options(s, o->predict_ms, o->use_delay_ms);
   s->add_flag("--json", o->json, "machine-readable results");

@@ -11,6 +11,8 @@ namespace skelgraph::cli {
 struct SimEvalOptions {
   // -p NAME=VALUE for the simulator; the scenarios to run; fusion methods (empty: all)
   std::vector<std::string> params, scenarios{"walk", "360", "hide", "box", "occ", "sit", "arms"}, methods;
+  // Sensor layouts "LAYOUT:SENSORS" (e.g. ring:4), each run with every scenario; empty: the -p parameters alone.
+  std::vector<std::string> layouts;
   double delay_ms = 0, max_age_ms = 100;
   double predict_ms = 0;    // kalman: predict each joint this far past the fusion time
   double use_delay_ms = 0;  // score every stream against the truth this long after each output (time of use)

@@ -5,6 +5,7 @@
 #include <deque>
 #include <limits>
 #include <optional>
+#include <set>
 #include <stdexcept>
 #include <string>
 
@@ -96,6 +97,7 @@ struct Evaluator::Impl {
     OffsetModel offsets;
     std::string recorded;  // a live fusion component's output id: its recorded skeletons, no fuser
     std::map<std::uint32_t, std::pair<std::int64_t, skeleton::Skeleton>> latest;  // recorded: per person
+    std::map<std::uint32_t, std::uint32_t> id_of_truth;  // true person -> the output id it last had
   };
 
   std::map<std::string, Eigen::Isometry3d> poses;
@@ -107,6 +109,8 @@ struct Evaluator::Impl {
   TruthTimeline truth;
   OfflineResult result;
   std::int64_t first_truth = 0, last_event = 0, last_raw = 0, next_tick = 0;
+  std::int64_t last_scored_tick = std::numeric_limits<std::int64_t>::min();
+  double tick_s = 0;  // since the tick before (at most 0.1 s), for person_seconds
   std::int64_t done_until = std::numeric_limits<std::int64_t>::min();
   bool any_truth = false, any_raw = false, any_event = false;
   std::size_t next_tick_index = 0;  // into options.tick_times
@@ -179,6 +183,10 @@ struct Evaluator::Impl {
     const std::int64_t at = tick - options.fuser.delay_ns;
     truth.forget_before(at - 1'000'000'000);
     const bool truth_here = truth.covers(at);
+    tick_s = last_scored_tick == std::numeric_limits<std::int64_t>::min()
+                 ? 0.0
+                 : std::min(0.1, static_cast<double>(tick - last_scored_tick) * 1e-9);
+    last_scored_tick = tick;
     const bool truth_at_use = options.use_delay_ns > 0 && truth.covers(at + options.use_delay_ns);
     std::vector<bool> complete(lanes.size(), false);  // a skeleton of the lane has the whole upper body at confidence 1
     for (std::size_t i = 0; i < lanes.size(); ++i) {
@@ -245,12 +253,21 @@ struct Evaluator::Impl {
       return t ? ((*t)[skeleton::JointId::Torso].position - *c).norm() : std::numeric_limits<double>::infinity();
     };
     std::stable_sort(order.begin(), order.end(), [&](auto* a, auto* b) { return dist(a) < dist(b); });
+    std::set<std::uint32_t> people_seen;  // true people given their nearest output this tick
     for (const auto* fp : order) {
       const auto& f = *fp;
       const auto c = skeleton::centre_of(f);
       if (!c) continue;
       const auto t = truth.at(at, *c);
       if (!t || ((*t)[skeleton::JointId::Torso].position - *c).norm() > 1.0) continue;  // a ghost, not the person
+      if (people_seen.insert(t->person_id).second) {
+        const auto [was, first] = lane.id_of_truth.try_emplace(t->person_id, f.person_id);
+        if (!first && was->second != f.person_id) {
+          ++lane.score.id_switches;
+          was->second = f.person_id;
+        }
+        lane.score.person_seconds += tick_s;
+      }
       lane.score.accuracy.add(f, *t);
       lane.score.uncertainty.add(f, *t);
       scored = true;

@@ -60,7 +60,9 @@ nlohmann::json stream_json(const StreamScore& s) {
             {"median_sigma_cm", num(s.uncertainty.median_sigma_cm())},
             {"reliability", s.uncertainty.reliability()}}},
           {"ticks", s.ticks},
-          {"ticks_with_output", s.with_output}};
+          {"ticks_with_output", s.with_output},
+          {"id_switches", s.id_switches},
+          {"id_switches_per_person_minute", num(s.id_switches_per_person_minute())}};
 }
 
 RecordingInputs read_recording(const std::string& file, bool shared_frame, const std::string& calibration) {

@@ -231,6 +231,8 @@ nlohmann::json SimComponent::details() const {
   return {{"scenario", config_.scenario.name},
           {"seed", config_.scenario.seed},
           {"profile", config_.profile},
+          // The tracker model's lag: what fusion's capture_latency_ms should say for these sensors.
+          {"capture_latency_ms", TrackerProfile::by_name(config_.profile).lag_s * 1e3},
           {"people", config_.scenario.people},
           {"duration_s", sim_->duration()},
           {"sensors", sensors},

@@ -69,6 +69,14 @@ struct StreamScore {
   Steadiness steadiness;
   UncertaintyCheck uncertainty;   // against truth, the joints that carry a covariance (kalman)
   std::uint64_t ticks = 0, with_output = 0;
+  // Identity: times a true person's nearest output (within 1 m) carried
+  // another person id than the last output that person had; and the
+  // seconds true people had an output, summed over people.
+  std::uint64_t id_switches = 0;
+  double person_seconds = 0;
+  double id_switches_per_person_minute() const {
+    return person_seconds > 0 ? 60.0 * static_cast<double>(id_switches) / person_seconds : std::nan("");
+  }
   // Ticks on which some single sensor had the whole upper body at confidence
   // 1, and of those, the ticks this stream had it too: how much of what any
   // one sensor tracks the stream keeps.
