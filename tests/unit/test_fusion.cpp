@@ -405,6 +405,39 @@ TEST(Fusion, KalmanCorrectsASensorThatSeesTheBack) {
   EXPECT_GE(f.stats().flips_corrected, 20u);
 }
 
+// Three sensors, two of them behind the person (both mirror the person: left
+// and right swapped), the first seen of them among those: the heading starts
+// the wrong way round. The person walks forwards at 0.5 m/s; walking is
+// evidence for the way they face, so the heading turns round and the
+// fused left hand ends up on the person's left.
+TEST(Fusion, KalmanTakesTheWayAPersonWalksAsTheWayTheyFace) {
+  fusion::FuserOptions o;
+  o.method = fusion::Method::Kalman;
+  fusion::Fuser f(o);
+  const Vector3d front(0, 1.2, 3), back_left(2, 1.2, -2.5), back_right(-2, 1.2, -2.5);
+  for (const auto& [id, at] : {std::pair{"b1", back_left}, std::pair{"b2", back_right}, std::pair{"f", front}}) {
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.translation() = at;
+    f.set_pose(id, pose);
+  }
+  int left_ok = 0;
+  for (int k = 0; k < 90; ++k) {
+    const std::int64_t t = k * 33 * kMs;
+    const Vector3d at(0, 1, -0.5 + 0.5 * 0.033 * k);  // walking towards +z, the way they face
+    for (const auto& [id, pos] : {std::pair{"b1", back_left}, std::pair{"b2", back_right}}) {
+      auto mirrored = person(id, 1, at);
+      skeleton::swap_sides(mirrored);
+      f.add(in_sensor(mirrored, pos), t);
+    }
+    f.add(in_sensor(person("f", 1, at), front), t);
+    const auto out = f.fuse(t + kMs);
+    ASSERT_EQ(out.size(), 1u);
+    if (k >= 60) left_ok += out[0][JointId::LeftHand].position.x() > 0.2 ? 1 : 0;  // the person's left is +x
+  }
+  EXPECT_EQ(left_ok, 30);
+  EXPECT_GE(f.stats().headings_reversed, 1u);
+}
+
 TEST(Fusion, KalmanGatesAnOutlier) {
   auto f = make(fusion::Method::Kalman);
   for (int k = 0; k < 30; ++k) {

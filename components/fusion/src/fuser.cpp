@@ -44,6 +44,10 @@ constexpr std::int64_t kSettledNs = 1'000'000'000;  // a tracker's fresh skeleto
 // hips; a pair of views (in front, behind) whose recent arm confidences differ by over the margin. Kept with
 // this memory per frame (30 Hz: about 3 s), at most kBeliefMax; the heading turned round below -kReverseAt.
 constexpr double kLeanAt = 0.15, kLeanWeight = 0.3;
+// People walk forwards: torso moving at kWalkAt m/s or faster (horizontal,
+// smoothed over about 0.3 s), within 60 degrees of a heading or its reverse,
+// is this much evidence for that one.
+constexpr double kWalkAt = 0.35, kWalkWeight = 0.3, kWalkMemory = 0.9;
 constexpr double kConfWeight = 0.5, kConfMargin = 0.02;
 constexpr double kBeliefMemory = 0.99, kBeliefMax = 10.0, kReverseAt = 3.0;
 constexpr double kArmMemory = 0.97;
@@ -115,6 +119,7 @@ struct Track {
   std::uint32_t id = 0;
   std::int64_t last_ns = 0;
   Vector3d centre = Vector3d::Zero();
+  Vector3d velocity = Vector3d::Zero();  // of the centre, horizontal, smoothed (kWalkMemory)
   std::optional<Vector3d> heading;  // horizontal unit vector the torso faces
   double heading_belief = 0;        // evidence for the heading over its reverse (log-odds; negative: against it)
   std::array<JointFilter, kJointCount> filters;
@@ -286,13 +291,17 @@ struct Fuser::Impl {
       for (const View* b : vs) opposite = opposite || (settled(a) && settled(b) && way(a).dot(way(b)) < -0.5);
     }
     if (!opposite) return 0;
+    double e = 0;
+    if (tr.velocity.norm() >= kWalkAt) {
+      const double c = tr.velocity.normalized().dot(h);
+      if (std::abs(c) >= 0.5) e += c > 0 ? kWalkWeight : -kWalkWeight;
+    }
     if (tr.frames > 0) {
       Vector3d lean = tr.last[JointId::Neck].position -
                       0.5 * (tr.last[JointId::LeftHip].position + tr.last[JointId::RightHip].position);
       lean.y() = 0;
-      if (lean.norm() > kLeanAt) return lean.dot(h) > 0 ? kLeanWeight : -kLeanWeight;
+      if (lean.norm() > kLeanAt) return e + (lean.dot(h) > 0 ? kLeanWeight : -kLeanWeight);
     }
-    double e = 0;
     for (const View* a : vs) {
       if (!settled(a) || h.dot(way(a)) < 0.3) continue;  // a: in front of the person, by h
       for (const View* b : vs) {
@@ -663,7 +672,14 @@ struct Fuser::Impl {
         }
         if (f.capture_oldest_ns != 0) break;
       }
-      if (const auto c = skeleton::centre_of(f)) tr.centre = *c;
+      if (const auto c = skeleton::centre_of(f)) {
+        if (tr.frames > 0 && t > tr.last_ns) {
+          Vector3d v = (*c - tr.centre) / (static_cast<double>(t - tr.last_ns) * 1e-9);
+          v.y() = 0;
+          tr.velocity = kWalkMemory * tr.velocity + (1 - kWalkMemory) * v;
+        }
+        tr.centre = *c;
+      }
       tr.last_ns = t;
       tr.last = f;
       ++tr.frames;
