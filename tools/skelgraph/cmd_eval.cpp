@@ -486,7 +486,15 @@ int eval_sim(const SimEvalOptions& o) {
     if (o.quiet) std::fprintf(stderr, "evaluated %s: %zu streams over %llu ticks\n", scenario.c_str(), r.streams.size(),
                               static_cast<unsigned long long>(r.ticks));
     nlohmann::json streams = nlohmann::json::array();
-    for (const auto& s : r.streams) streams.push_back(eval::stream_json(s));
+    for (std::size_t i = 0; i < r.streams.size(); ++i) {
+      streams.push_back(eval::stream_json(r.streams[i]));
+      if (i < r.fuser_stats.size()) {
+        const auto& f = r.fuser_stats[i];
+        streams.back()["fuser"] = {{"flips_corrected", f.flips_corrected}, {"gated", f.gated},
+                                   {"tracks_merged", f.tracks_merged},     {"headings_reversed", f.headings_reversed},
+                                   {"occluded_views", f.occluded_views},   {"fused", f.fused}};
+      }
+    }
     out.push_back({{"scenario", scenario}, {"sensors", cfg.sensors.size()}, {"profile", cfg.profile},
                    {"seed", cfg.scenario.seed}, {"ticks", r.ticks}, {"streams", streams}, {"source", o.source}});
     if (!layout.empty()) out.back()["layout"] = layout;
