@@ -72,14 +72,14 @@ TEST(ViewerScene, APersonWhoLeftIsNoLongerDrawn) {
 
 TEST(ViewerScene, FusedJointsCarryTheRadiusOfTheir95PercentRegion) {
   skeleton::Joint j;
-  EXPECT_EQ(radius_95(j), 0.0);
+  EXPECT_EQ(skeleton::radius_95(j), 0.0);
   // Variances 4 cm^2 along x, 1 cm^2 along y and z: the largest axis, sqrt(7.815 * 0.0004) = 5.59 cm.
   skeleton::set_covariance(j, Eigen::Vector3d(0.0004, 0.0001, 0.0001).asDiagonal());
-  EXPECT_NEAR(radius_95(j), 0.05591, 1e-5);
+  EXPECT_NEAR(skeleton::radius_95(j), 0.05591, 1e-5);
   // Rotated, the same ellipsoid has the same sphere.
   const Eigen::Matrix3d r = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
   skeleton::set_covariance(j, r * Eigen::Vector3d(0.0004, 0.0001, 0.0001).asDiagonal() * r.transpose());
-  EXPECT_NEAR(radius_95(j), 0.05591, 1e-4);
+  EXPECT_NEAR(skeleton::radius_95(j), 0.05591, 1e-4);
   Scene scene;
   auto s = person("fused", 3, "world", 9);
   skeleton::set_covariance(s.joints[5], Eigen::Matrix3d::Identity() * 0.0001);

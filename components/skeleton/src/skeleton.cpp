@@ -1,5 +1,9 @@
 #include "skelgraph/skeleton/skeleton.hpp"
 
+#include <cmath>
+
+#include <Eigen/Eigenvalues>
+
 namespace skelgraph::skeleton {
 
 namespace {
@@ -29,6 +33,13 @@ std::optional<Eigen::Vector3d> claimed_facing(const Skeleton& s, const Eigen::Ve
   const Eigen::Vector3d f = (l.position - r.position).cross(up);
   if (!(f.norm() > 1e-6)) return std::nullopt;
   return Eigen::Vector3d(f.normalized());
+}
+
+double radius_95(const Joint& j) {
+  if (!has_covariance(j)) return 0.0;
+  const double largest =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance_of(j), Eigen::EigenvaluesOnly).eigenvalues().maxCoeff();
+  return largest > 0.0 ? std::sqrt(7.815 * largest) : 0.0;
 }
 
 Eigen::Matrix3d covariance_of(const Joint& j) {

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include <Eigen/Eigenvalues>
 
 namespace skelgraph::viewer {
 
@@ -35,16 +34,7 @@ double mm(double v) { return std::round(v * 1000.0) / 1000.0; }
 nlohmann::json vec(const Eigen::Vector3d& v) { return {mm(v.x()), mm(v.y()), mm(v.z())}; }
 }  // namespace
 
-double radius_95(const skeleton::Joint& j) {
-  if (!skeleton::has_covariance(j)) return 0.0;
-  // The 95 % ellipsoid of a 3-D normal is x' C^-1 x <= 7.815 (chi-square, 3
-  // degrees of freedom); the sphere round it has the largest axis as radius.
-  const double largest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(skeleton::covariance_of(j),
-                                                                         Eigen::EigenvaluesOnly)
-                             .eigenvalues()
-                             .maxCoeff();
-  return largest > 0.0 ? std::sqrt(7.815 * largest) : 0.0;
-}
+
 
 void Scene::on_skeleton(const skeleton::Skeleton& s, std::int64_t now_ns) {
   const StreamKind kind = stream_kind(s.sensor_id);
@@ -95,7 +85,7 @@ nlohmann::json Scene::frame(std::int64_t now_ns) {
     for (const auto& j : s.joints) {
       const int state = joint_state(j.confidence);
       if (state == 0) joints.push_back({0, 0, 0, 0, 0});
-      else joints.push_back({mm(j.position.x()), mm(j.position.y()), mm(j.position.z()), state, mm(radius_95(j))});
+      else joints.push_back({mm(j.position.x()), mm(j.position.y()), mm(j.position.z()), state, mm(skeleton::radius_95(j))});
     }
     skeletons.push_back({{"stream", s.sensor_id},
                          {"kind", kind_name(it->second.kind)},

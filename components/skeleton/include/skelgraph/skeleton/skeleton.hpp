@@ -56,6 +56,10 @@ struct Joint {
 // A joint's covariance as a matrix, and set from one (upper triangle kept).
 Eigen::Matrix3d covariance_of(const Joint& j);
 void set_covariance(Joint& j, const Eigen::Matrix3d& c);
+// The radius of the sphere round a joint's 95 % region, m (the largest axis
+// of the ellipsoid x' C^-1 x <= 7.815, chi-square with 3 degrees of freedom);
+// 0 without a covariance.
+double radius_95(const Joint& j);
 inline bool has_covariance(const Joint& j) {
   for (const float v : j.covariance)
     if (v != 0.0f) return true;

@@ -29,8 +29,6 @@ StreamKind stream_kind(const std::string& sensor_id);
 
 // 2 tracked (confidence >= 0.75), 1 inferred (> 0), 0 lost.
 int joint_state(float confidence);
-// The radius of the sphere round a joint's 95 % region (m); 0 without a covariance.
-double radius_95(const skeleton::Joint& j);
 
 struct SceneOptions {
   std::int64_t max_age_ns = 500'000'000;       // skeletons older than this are not drawn

@@ -1,0 +1,207 @@
+// The robot core: UR5e kinematics against its published zero pose, the
+// Jacobian against finite differences, motion within the joint limits, the
+// stopping model obeyed; capsule distances; the protective separation
+// distance of ISO/TS 15066 and the decisions made on it, fail-safes included.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "skelgraph/robot/arm.hpp"
+#include "skelgraph/robot/capsule.hpp"
+#include "skelgraph/robot/separation.hpp"
+
+using namespace skelgraph;
+using namespace skelgraph::robot;
+using Eigen::Vector3d;
+
+TEST(RobotArm, Ur5eZeroPoseIsThePublishedOne) {
+  const auto m = ArmModel::ur5e();
+  const auto f = forward(m, Joints::Zero());
+  // Flange at zero: x = a2 + a3, y = -(d4 + d6), z = d1 - d5.
+  EXPECT_NEAR(f[6].translation().x(), -0.8172, 1e-9);
+  EXPECT_NEAR(f[6].translation().y(), -0.2329, 1e-9);
+  EXPECT_NEAR(f[6].translation().z(), 0.0628, 1e-9);
+  // The tool point lies tool_length further along the flange's z.
+  EXPECT_NEAR((f[7].translation() - f[6].translation()).norm(), m.tool_length, 1e-12);
+}
+
+TEST(RobotArm, JacobianMatchesFiniteDifferences) {
+  const auto m = ArmModel::ur5e();
+  Joints q;
+  q << 0.3, -1.2, 1.4, -0.7, 1.1, 0.4;
+  const auto j = position_jacobian(m, q);
+  for (int i = 0; i < 6; ++i) {
+    Joints dq = Joints::Zero();
+    dq(i) = 1e-6;
+    const Vector3d num = (forward(m, q + dq)[7].translation() - forward(m, q - dq)[7].translation()) / 2e-6;
+    EXPECT_LT((num - j.col(i)).norm(), 1e-6) << "joint " << i;
+  }
+}
+
+TEST(RobotArm, BasePoseStandsTheArmUpInTheYUpWorld) {
+  const auto p = base_pose(1.0, 0.0, 2.0, 0.0);
+  EXPECT_LT((p * Vector3d(0, 0, 0.5) - Vector3d(1.0, 0.5, 2.0)).norm(), 1e-12);  // base z is world up
+  const auto m = ArmModel::ur5e();
+  const auto caps = arm_capsules(m, Joints::Zero(), p);
+  ASSERT_EQ(caps.size(), 7u);
+  EXPECT_EQ(caps[0].name, "base");
+  EXPECT_NEAR(caps[0].b.y(), 0.1625, 1e-9);  // the shoulder above the floor
+}
+
+TEST(RobotArm, ReachesATargetWithinItsLimits) {
+  const auto m = ArmModel::ur5e();
+  Joints start;
+  start << 0.0, -1.57, 1.57, -1.57, -1.57, 0.0;
+  ArmSim arm(m, base_pose(0, 0.8, 0, 0), start);
+  const Vector3d target = arm.tool_world() + Vector3d(0.2, -0.1, 0.15);
+  arm.set_target(target, 0.25);
+  double max_tool = 0, max_joint = 0, max_accel = 0;
+  Joints last = Joints::Zero();
+  for (int k = 0; k < 500; ++k) {  // 5 s at 100 Hz
+    arm.step(0.01);
+    max_tool = std::max(max_tool, arm.tool_speed());
+    max_joint = std::max(max_joint, arm.joint_speeds().cwiseAbs().maxCoeff());
+    max_accel = std::max(max_accel, ((arm.joint_speeds() - last) / 0.01).cwiseAbs().maxCoeff());
+    last = arm.joint_speeds();
+  }
+  EXPECT_LT((arm.tool_world() - target).norm(), 0.005);
+  EXPECT_LT(max_tool, 0.25 * 1.02);
+  EXPECT_LE(max_joint, m.max_speed.maxCoeff() + 1e-9);
+  EXPECT_LE(max_accel, m.max_accel.maxCoeff() + 1e-6);
+  // Half the speed scale: the tool goes half as fast.
+  arm.set_speed_scale(0.5);
+  arm.set_target(target + Vector3d(-0.3, 0, 0), 0.25);
+  double top = 0;
+  for (int k = 0; k < 300; ++k) {
+    arm.step(0.01);
+    top = std::max(top, arm.tool_speed());
+  }
+  EXPECT_LT(top, 0.125 * 1.02);
+  EXPECT_GT(top, 0.1);
+}
+
+TEST(RobotArm, AProtectiveStopKeepsToTheStoppingModel) {
+  const auto m = ArmModel::ur5e();
+  Joints start;
+  start << 0.0, -1.57, 1.57, -1.57, -1.57, 0.0;
+  ArmSim arm(m, base_pose(0, 0.8, 0, 0), start);
+  arm.set_target(arm.tool_world() + Vector3d(0.6, 0, 0), 0.5);
+  for (int k = 0; k < 100; ++k) arm.step(0.005);
+  const double v0 = arm.tool_speed();
+  ASSERT_GT(v0, 0.3);
+  const Vector3d from = arm.tool_world();
+  arm.protective_stop();
+  double t = 0, path = 0;
+  Vector3d at = from;
+  while (arm.tool_speed() > 0 && t < 2.0) {
+    arm.step(0.005);
+    t += 0.005;
+    path += (arm.tool_world() - at).norm();
+    at = arm.tool_world();
+  }
+  EXPECT_EQ(arm.tool_speed(), 0.0);
+  EXPECT_LE(t, m.stopping.time_s(v0) + 0.01);
+  EXPECT_LE(path, m.stopping.distance_m(v0) + 0.005);
+  // Held until resumed.
+  for (int k = 0; k < 50; ++k) arm.step(0.01);
+  EXPECT_LT((arm.tool_world() - at).norm(), 1e-9);
+  arm.resume();
+  for (int k = 0; k < 50; ++k) arm.step(0.01);
+  EXPECT_GT((arm.tool_world() - at).norm(), 0.05);
+}
+
+TEST(Capsules, DistancesOfSegmentsAndCapsules) {
+  // Crossing at right angles, 1 m apart.
+  EXPECT_NEAR(segment_distance({-1, 0, 0}, {1, 0, 0}, {0, -1, 1}, {0, 1, 1}), 1.0, 1e-12);
+  // Parallel, overlapping in extent.
+  EXPECT_NEAR(segment_distance({0, 0, 0}, {1, 0, 0}, {0.5, 0.3, 0}, {2, 0.3, 0}), 0.3, 1e-12);
+  // End to end.
+  EXPECT_NEAR(segment_distance({0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {3, 0, 0}), 1.0, 1e-12);
+  // Points.
+  EXPECT_NEAR(segment_distance({0, 0, 0}, {0, 0, 0}, {0, 3, 4}, {0, 3, 4}), 5.0, 1e-12);
+  const Capsule a{{0, 0, 0}, {1, 0, 0}, 0.1, "a"}, b{{0, 0.5, 0}, {1, 0.5, 0}, 0.15, "b"};
+  EXPECT_NEAR(capsule_distance(a, b), 0.25, 1e-12);
+  const auto c = closest({a, b}, {Capsule{{0.5, 2, 0}, {0.5, 3, 0}, 0.0, "far"}});
+  EXPECT_EQ(c.first, 1u);
+  EXPECT_NEAR(c.distance, 1.35, 1e-12);
+}
+
+TEST(Separation, ProtectiveDistanceFollowsTheFormula) {
+  SeparationParams p;
+  StoppingModel stop;  // 50 ms reaction, 2.5 m/s^2
+  // v_r 0.5 m/s, T_r 0.1 s, Z_d 0.05 m, 1 m away: v_h 1.6.
+  // T_s = 0.05 + 0.2 = 0.25; S_s = 0.025 + 0.05 = 0.075.
+  // S_p = 1.6 (0.35) + 0.05 + 0.075 + 0 + 0.05 + 0.01 = 0.745
+  EXPECT_NEAR(protective_distance(p, stop, 1.0, 0.5, 0.1, 0.05), 0.745, 1e-12);
+  // Under 0.5 m the person is taken to move at 2.0 m/s.
+  EXPECT_NEAR(protective_distance(p, stop, 0.4, 0.5, 0.1, 0.05), 0.745 + 0.4 * 0.35, 1e-12);
+}
+
+TEST(Separation, DecidesRunReducedOrStopAndFailsSafe) {
+  SeparationParams p;
+  StoppingModel stop;
+  SeparationInput in;
+  in.robot_max_speed = 1.0;
+  in.robot_speed = 1.0;
+  in.reaction_s = 0.1;
+  in.person_uncertainty_m = 0.05;
+  in.closest = "person 1 right_hand / tool";
+  const double full = protective_distance(p, stop, 3.0, 1.0, 0.1, 0.05);
+  in.separation_m = full + p.margin_m + 0.01;
+  auto d = decide(p, stop, in);
+  EXPECT_EQ(d.state, SafetyState::Run);
+  EXPECT_EQ(d.speed_scale, 1.0);
+  // Closer, the robot already slower: a reduced speed that fits (S_p at it plus the margin within the separation).
+  in.robot_speed = 0.3;
+  in.separation_m = full - 0.1;
+  d = decide(p, stop, in);
+  ASSERT_EQ(d.state, SafetyState::Reduced) << d.reason;
+  EXPECT_GT(d.speed_scale, p.min_scale);
+  EXPECT_LT(d.speed_scale, 1.0);
+  EXPECT_NEAR(protective_distance(p, stop, in.separation_m, d.speed_scale, 0.1, 0.05) + p.margin_m, in.separation_m, 1e-6);
+  // Within S_p at the speed it has: stop, naming the closest part.
+  in.robot_speed = 1.0;
+  d = decide(p, stop, in);
+  EXPECT_EQ(d.state, SafetyState::ProtectiveStop);
+  EXPECT_EQ(d.speed_scale, 0.0);
+  EXPECT_NE(d.reason.find("person 1 right_hand / tool"), std::string::npos) << d.reason;
+  // Nobody there: run.
+  in.separation_m = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(decide(p, stop, in).state, SafetyState::Run);
+  // Fail-safe: stale people data, stale robot state, a lost sensor, a person fusion cannot place.
+  for (int k = 0; k < 4; ++k) {
+    SeparationInput bad = in;
+    bad.separation_m = 10.0;  // far away: only the fail-safe stops it
+    if (k == 0) bad.people_age_s = 0.3;
+    if (k == 1) bad.robot_age_s = 0.2;
+    if (k == 2) bad.coverage_lost = true;
+    if (k == 3) bad.unplaced_person = true;
+    const auto s2 = decide(p, stop, bad);
+    EXPECT_EQ(s2.state, SafetyState::ProtectiveStop) << k;
+    EXPECT_FALSE(s2.reason.empty());
+  }
+  SeparationInput fresh = in;
+  fresh.separation_m = 10.0;
+  EXPECT_EQ(decide(p, stop, fresh).state, SafetyState::Run);
+}
+
+TEST(Separation, PersonCapsulesComeFromTheReportedJointsWithTheirUncertainty) {
+  skeleton::Skeleton s;
+  for (auto& j : s.joints) j.confidence = skeleton::kTracked;
+  s[skeleton::JointId::RightHand].position = Vector3d(0.5, 1.0, 0.2);
+  s[skeleton::JointId::RightElbow].position = Vector3d(0.4, 1.1, 0.0);
+  skeleton::set_covariance(s[skeleton::JointId::RightHand], Eigen::Matrix3d::Identity() * 0.0004);
+  std::vector<double> u;
+  auto caps = person_capsules(s, &u);
+  ASSERT_EQ(caps.size(), u.size());
+  EXPECT_EQ(caps.size(), 14u);  // 13 parts and the lower trunk
+  std::size_t hand = 0;
+  while (hand < caps.size() && caps[hand].name != "right_hand") ++hand;
+  ASSERT_LT(hand, caps.size());
+  EXPECT_NEAR(u[hand], std::sqrt(7.815 * 0.0004), 1e-9);
+  // A joint not reported takes its parts away.
+  s[skeleton::JointId::RightHand].confidence = 0;
+  caps = person_capsules(s);
+  EXPECT_EQ(caps.size(), 12u);  // no right forearm, no right hand
+}
