@@ -570,20 +570,27 @@ TEST(JointFilter, ConvergesOnAMovingPointAndEstimatesItsVelocity) {
 // The simulator's 360 scenario with two sensors: fusion keeps the arms far more
 // often than either sensor alone, and the filter is more accurate than the best single sensor.
 namespace {
-// A simulated run through every method: the streams' scores by name.
-std::map<std::string, eval::StreamScore> simulated(const std::string& scenario, int sensors, std::uint64_t seed) {
-  sim::SimConfig cfg;
-  cfg.scenario.name = scenario;
-  cfg.scenario.seed = seed;
-  cfg.sensors = sim::default_sensors(sensors);
+// A whole simulated run as evaluation events, and the sensors' true poses.
+std::vector<eval::TimedSkeleton> simulated_events(const sim::SimConfig& cfg,
+                                                  std::map<std::string, Eigen::Isometry3d>& poses) {
   sim::Simulation sim(cfg);
-  std::map<std::string, Eigen::Isometry3d> poses;
   for (const auto& s : cfg.sensors) poses[s.id] = s.world_from_sensor();
   std::vector<eval::TimedSkeleton> events;
   for (auto& e : sim.advance(sim.duration() + 1)) {
     events.push_back({e.kind == sim::SimEvent::Kind::Truth ? eval::TimedSkeleton::Kind::Truth : eval::TimedSkeleton::Kind::Raw,
                       static_cast<std::int64_t>(std::llround(e.t * 1e9)), std::move(e.skeleton)});
   }
+  return events;
+}
+
+// A simulated run through every method: the streams' scores by name.
+std::map<std::string, eval::StreamScore> simulated(const std::string& scenario, int sensors, std::uint64_t seed) {
+  sim::SimConfig cfg;
+  cfg.scenario.name = scenario;
+  cfg.scenario.seed = seed;
+  cfg.sensors = sim::default_sensors(sensors);
+  std::map<std::string, Eigen::Isometry3d> poses;
+  const auto events = simulated_events(cfg, poses);
   std::map<std::string, eval::StreamScore> by;
   for (auto& s : eval::evaluate(poses, events, {}).streams) by.emplace(s.name, std::move(s));
   return by;
@@ -688,14 +695,8 @@ TEST(Fusion, KalmanPublishesEachJointsUncertainty) {
 TEST(Evaluation, EveryStreamIsScoredAtItsTimeAndAtTheTimeOfUse) {
   sim::SimConfig cfg;
   cfg.scenario.name = "walk";
-  sim::Simulation sim(cfg);
   std::map<std::string, Eigen::Isometry3d> poses;
-  for (const auto& s : cfg.sensors) poses[s.id] = s.world_from_sensor();
-  std::vector<eval::TimedSkeleton> events;
-  for (auto& e : sim.advance(sim.duration() + 1)) {
-    events.push_back({e.kind == sim::SimEvent::Kind::Truth ? eval::TimedSkeleton::Kind::Truth : eval::TimedSkeleton::Kind::Raw,
-                      static_cast<std::int64_t>(std::llround(e.t * 1e9)), std::move(e.skeleton)});
-  }
+  const auto events = simulated_events(cfg, poses);
   eval::OfflineOptions o;
   o.methods = {fusion::Method::Kalman};
   const auto now = eval::evaluate(poses, events, o);
