@@ -179,4 +179,57 @@ void to_json(nlohmann::json& j, const PlayState& v) {
        {"position_s", v.position_s()}, {"duration_s", v.duration_s()}};
 }
 
+const char* to_string(RobotCommandKind k) {
+  switch (k) {
+    case ROBOT_MOVE_TO: return "MOVE_TO";
+    case ROBOT_HOLD: return "HOLD";
+    case ROBOT_SPEED_SCALE: return "SPEED_SCALE";
+    case ROBOT_PROTECTIVE_STOP: return "PROTECTIVE_STOP";
+    case ROBOT_RESUME: return "RESUME";
+  }
+  return "UNKNOWN";
+}
+
+const char* to_string(SafetyStateKind k) {
+  switch (k) {
+    case SAFETY_RUN: return "RUN";
+    case SAFETY_REDUCED: return "REDUCED";
+    case SAFETY_PROTECTIVE_STOP: return "PROTECTIVE_STOP";
+  }
+  return "UNKNOWN";
+}
+
+void to_json(nlohmann::json& j, const Capsule& v) {
+  j = {{"a", v.a()}, {"b", v.b()}, {"radius", v.radius()}, {"name", v.name().to_string()}};
+}
+
+void to_json(nlohmann::json& j, const RobotState& v) {
+  j = {{"robot_id", v.robot_id().to_string()},
+       {"model", v.model().to_string()},
+       {"stamp_ns", v.stamp_ns()},
+       {"joints", v.joints()},
+       {"joint_speeds", v.joint_speeds()},
+       {"tool_position", v.tool_position()},
+       {"tool_speed", v.tool_speed()},
+       {"speed_scale", v.speed_scale()},
+       {"protective_stop", v.protective_stop()},
+       {"has_target", v.has_target()},
+       {"target", v.target()},
+       {"capsules", v.capsules()}};
+}
+
+void to_json(nlohmann::json& j, const RobotCommand& v) {
+  j = {{"robot_id", v.robot_id().to_string()}, {"kind", to_string(v.kind())}, {"target", v.target()},
+       {"value", v.value()}, {"source", v.source().to_string()}, {"stamp_ns", v.stamp_ns()}};
+}
+
+void to_json(nlohmann::json& j, const SafetyStatus& v) {
+  j = {{"robot_id", v.robot_id().to_string()},     {"stamp_ns", v.stamp_ns()},
+       {"state", to_string(v.state())},            {"speed_scale", v.speed_scale()},
+       {"separation_m", v.separation_m()},         {"protective_m", v.protective_m()},
+       {"person_id", v.person_id()},               {"body_part", v.body_part().to_string()},
+       {"robot_part", v.robot_part().to_string()}, {"people_age_ms", v.people_age_ms()},
+       {"reaction_ms", v.reaction_ms()},           {"reason", v.reason().to_string()}};
+}
+
 }  // namespace skelgraph::msg

@@ -32,7 +32,8 @@ const std::vector<MessageInfo>& message_table() {
       make_info<SyncAck>(),    make_info<SensorPose>(),   make_info<DepthFrame>(),
       make_info<GestureEvent>(), make_info<ComponentStatus>(), make_info<ClockOffset>(),
       make_info<TickFrames>(), make_info<SensorFrame>(), make_info<GestureState>(),
-      make_info<PointCloud>(), make_info<PlayControl>(), make_info<PlayState>()};
+      make_info<PointCloud>(), make_info<PlayControl>(), make_info<PlayState>(),
+      make_info<RobotState>(), make_info<RobotCommand>(), make_info<SafetyStatus>()};
   return table;
 }
 

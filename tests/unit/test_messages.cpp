@@ -73,7 +73,7 @@ TEST(Messages, TableCoversEveryTopLevelTypeOnce) {
   const std::vector<std::string> expected = {"Skeleton",   "SyncCommand",  "SyncControl", "SyncAck",
                                              "SensorPose", "DepthFrame",   "GestureEvent", "ComponentStatus",
                                              "ClockOffset", "TickFrames", "SensorFrame", "GestureState", "PointCloud",
-                                             "PlayControl", "PlayState"};
+                                             "PlayControl", "PlayState", "RobotState", "RobotCommand", "SafetyStatus"};
   ASSERT_EQ(message_table().size(), expected.size());
   for (const auto& name : expected) {
     const auto* info = find_message("skelgraph::msg::" + name);

@@ -83,6 +83,8 @@ SafetyDecision decide(const SeparationParams& p, const StoppingModel& stop, cons
   };
   // Fail-safe first: what the decision would rest on is not known well enough.
   std::ostringstream why;
+  if (!std::isfinite(in.people_age_s)) return stop_because("no people data yet (no sensor frames, no fused skeletons)");
+  if (!std::isfinite(in.robot_age_s)) return stop_because("no robot state yet");
   if (in.people_age_s > p.max_people_age_s) {
     why << "people data " << std::lround(in.people_age_s * 1e3) << " ms old (limit " << std::lround(p.max_people_age_s * 1e3)
         << " ms)";

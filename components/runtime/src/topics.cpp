@@ -16,6 +16,7 @@ const std::vector<TopicInfo>& known_topics() {
       info(topics::kSkeletonTruth), info(topics::kDepth),        info(topics::kCalibration),
       info(topics::kGestureEvent), info(topics::kGestureState), info(topics::kCloud),
       info(topics::kPlayControl), info(topics::kPlayState),
+      info(topics::kRobotState), info(topics::kRobotCommand), info(topics::kSafety),
       info(topics::kStatus)};
   return table;
 }

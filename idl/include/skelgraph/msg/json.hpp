@@ -37,9 +37,15 @@ void to_json(nlohmann::json& j, const PlayControl& v);
 void to_json(nlohmann::json& j, const PlayState& v);
 void to_json(nlohmann::json& j, const TopicStats& v);
 void to_json(nlohmann::json& j, const ComponentStatus& v);
+void to_json(nlohmann::json& j, const Capsule& v);
+void to_json(nlohmann::json& j, const RobotState& v);
+void to_json(nlohmann::json& j, const RobotCommand& v);
+void to_json(nlohmann::json& j, const SafetyStatus& v);
 
 const char* to_string(SyncKind k);
 const char* to_string(ComponentState s);
 const char* to_string(PlayKind k);
+const char* to_string(RobotCommandKind k);  // "MOVE_TO", "HOLD", ...
+const char* to_string(SafetyStateKind k);   // "RUN", "REDUCED", "PROTECTIVE_STOP"
 
 }  // namespace skelgraph::msg

@@ -56,8 +56,8 @@ struct SeparationInput {
   double robot_speed = 0;          // tool speed now, m/s
   double robot_max_speed = 1.0;    // the speed asked of it, m/s
   double reaction_s = 0.1;         // T_r, measured
-  double people_age_s = 0;         // how old the people data is
-  double robot_age_s = 0;          // how old the robot state is
+  double people_age_s = 0;         // how old the people data is (+inf: none yet)
+  double robot_age_s = 0;          // how old the robot state is (+inf: none yet)
   bool coverage_lost = false;      // a sensor covering the robot's surroundings is lost and none other covers it
   bool unplaced_person = false;    // fusion reports a person it cannot place
 };

@@ -76,6 +76,12 @@ inline const TopicDef<msg::PointCloud> kCloud{"skelgraph/cloud", {R::BestEffort,
 // state (keyed by player; late joiners get the latest).
 inline const TopicDef<msg::PlayControl> kPlayControl{"skelgraph/play/control", {R::Reliable, D::Volatile, 0}};
 inline const TopicDef<msg::PlayState> kPlayState{"skelgraph/play/state", {R::Reliable, D::TransientLocal, 16, 64}};
+// The robot: its state at its control rate (the latest matters), requests to
+// it (none lost), and the separation monitor's verdict per robot (none lost;
+// the latest kept for late joiners).
+inline const TopicDef<msg::RobotState> kRobotState{"skelgraph/robot/state", {R::BestEffort, D::Volatile, 1, 16}};
+inline const TopicDef<msg::RobotCommand> kRobotCommand{"skelgraph/robot/command", {R::Reliable, D::Volatile, 0}};
+inline const TopicDef<msg::SafetyStatus> kSafety{"skelgraph/safety", {R::Reliable, D::TransientLocal, 1, 16}};
 inline const TopicDef<msg::ComponentStatus> kStatus{"skelgraph/status", {R::BestEffort, D::Volatile, 1, 256}};
 
 }  // namespace topics

@@ -1,0 +1,159 @@
+#include "skelgraph/robot/robot_component.hpp"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
+
+#include <spdlog/spdlog.h>
+
+#include "skelgraph/runtime/topics.hpp"
+
+namespace skelgraph::robot {
+
+namespace {
+std::vector<double> numbers(const std::string& text, std::size_t count, const char* what) {
+  std::vector<double> out;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    std::size_t used = 0;
+    double v = 0;
+    try {
+      v = std::stod(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != item.size() || !std::isfinite(v))
+      throw std::invalid_argument(std::string(what) + ": '" + item + "' in '" + text + "' is not a number");
+    out.push_back(v);
+  }
+  if (out.size() != count) {
+    throw std::invalid_argument(std::string(what) + ": '" + text + "' has " + std::to_string(out.size()) +
+                                " numbers, expected " + std::to_string(count));
+  }
+  return out;
+}
+void set(msg::Vec3& m, const Eigen::Vector3d& v) {
+  m.x(v.x());
+  m.y(v.y());
+  m.z(v.z());
+}
+}  // namespace
+
+Eigen::Isometry3d parse_base(const std::string& text) {
+  const auto v = numbers(text, 4, "base (x,y,z,yaw_deg)");
+  return base_pose(v[0], v[1], v[2], v[3]);
+}
+
+Joints parse_joints_deg(const std::string& text) {
+  const auto v = numbers(text, 6, "start_joints_deg (six angles)");
+  Joints q;
+  for (int i = 0; i < 6; ++i) q(i) = v[static_cast<std::size_t>(i)] * M_PI / 180.0;
+  return q;
+}
+
+msg::RobotState state_msg(const std::string& robot_id, const ArmSim& arm, std::int64_t stamp_ns) {
+  msg::RobotState s;
+  s.robot_id(robot_id);
+  s.model(arm.model().name);
+  s.stamp_ns(stamp_ns);
+  for (int i = 0; i < 6; ++i) {
+    s.joints()[static_cast<std::size_t>(i)] = arm.joints()(i);
+    s.joint_speeds()[static_cast<std::size_t>(i)] = arm.joint_speeds()(i);
+  }
+  set(s.tool_position(), arm.tool_world());
+  s.tool_speed(arm.tool_speed());
+  s.speed_scale(arm.speed_scale());
+  s.protective_stop(arm.stopped());
+  s.has_target(arm.has_target());
+  for (const auto& c : arm.capsules()) {
+    msg::Capsule m;
+    set(m.a(), c.a);
+    set(m.b(), c.b);
+    m.radius(c.radius);
+    m.name(c.name);
+    s.capsules().push_back(m);
+  }
+  return s;
+}
+
+runtime::ComponentInfo RobotComponent::describe() {
+  runtime::ComponentInfo info{"robot",
+                              "A simulated 6-axis arm (UR5e kinematics) in the cell: its state on skelgraph/robot/state, "
+                              "requests on skelgraph/robot/command",
+                              {}};
+  info.params.add_string("robot_id", "robot1", "the robot's id (key of its state; commands for it or for '')")
+      .add_string("model", "ur5e", "arm model", {"ur5e"})
+      .add_string("base", "0,0,1.5,180", "where its base stands: x,y,z (m, world; y up) and yaw (deg about the vertical)")
+      .add_string("start_joints_deg", "0,-90,90,-90,-90,0", "joint angles at start, degrees")
+      .add_double("rate_hz", 100.0, "control and state rate", 1.0, 1000.0);
+  return info;
+}
+
+RobotComponent::RobotComponent(runtime::Context& ctx, const runtime::Params& params)
+    : Component(ctx),
+      id_(params.get<std::string>("robot_id")),
+      arm_(ArmModel::ur5e(), parse_base(params.get<std::string>("base")),
+           parse_joints_deg(params.get<std::string>("start_joints_deg"))),
+      rate_hz_(params.get<double>("rate_hz")),
+      state_pub_(ctx, runtime::topics::kRobotState),
+      command_sub_(ctx, runtime::topics::kRobotCommand,
+                   [this](const msg::RobotCommand& c, const runtime::SampleMeta&) { on_command(c); }) {}
+
+void RobotComponent::on_start() {
+  last_mono_ns_ = ctx_.clock().monotonic_ns();
+  ctx_.set_health(runtime::HealthState::Ok, "running");
+  timer_ = ctx_.executor().every(std::chrono::nanoseconds(static_cast<std::int64_t>(1e9 / rate_hz_)), [this] { step(); },
+                                 true);
+}
+
+void RobotComponent::on_command(const msg::RobotCommand& c) {
+  if (c.robot_id().size() > 0 && c.robot_id().to_string() != id_) {
+    ++ignored_;
+    return;
+  }
+  ++commands_;
+  const Eigen::Vector3d target(c.target().x(), c.target().y(), c.target().z());
+  switch (c.kind()) {
+    case msg::ROBOT_MOVE_TO: arm_.set_target(target, c.value() > 0 ? c.value() : 0.25); break;
+    case msg::ROBOT_HOLD: arm_.clear_target(); break;
+    case msg::ROBOT_SPEED_SCALE: arm_.set_speed_scale(c.value()); break;
+    case msg::ROBOT_PROTECTIVE_STOP:
+      if (!arm_.stopped()) {
+        ++stops_;
+        spdlog::warn("{}: protective stop asked by {}", ctx_.name(), c.source().to_string());
+      }
+      arm_.protective_stop();
+      break;
+    case msg::ROBOT_RESUME: arm_.resume(); break;
+  }
+}
+
+void RobotComponent::step() {
+  const auto now = ctx_.clock().monotonic_ns();
+  const double dt = std::min(0.1, static_cast<double>(now - last_mono_ns_) * 1e-9);
+  last_mono_ns_ = now;
+  arm_.step(dt);
+  ++steps_;
+  if (state_pub_.publish(state_msg(id_, arm_, ctx_.clock().now_ns()))) ++published_;
+  ctx_.set_health(runtime::HealthState::Ok, arm_.stopped() ? "protective stop" : "running");
+}
+
+std::string RobotComponent::summary() const {
+  std::ostringstream os;
+  os << id_ << " (" << arm_.model().name << "): " << published_ << " states, " << commands_ << " commands, " << stops_
+     << " protective stop(s)";
+  return os.str();
+}
+
+nlohmann::json RobotComponent::details() const {
+  const auto t = arm_.tool_world();
+  return {{"robot_id", id_},   {"model", arm_.model().name}, {"steps", steps_},         {"published", published_},
+          {"commands", commands_}, {"ignored", ignored_},     {"protective_stops", stops_},
+          {"stopped", arm_.stopped()}, {"speed_scale", arm_.speed_scale()}, {"tool", {t.x(), t.y(), t.z()}}};
+}
+
+}  // namespace skelgraph::robot
+
+SKELGRAPH_REGISTER_COMPONENT(robot, skelgraph::robot::RobotComponent)
