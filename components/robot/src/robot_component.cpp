@@ -1,5 +1,6 @@
 #include "skelgraph/robot/robot_component.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -46,6 +47,11 @@ Eigen::Isometry3d parse_base(const std::string& text) {
   return base_pose(v[0], v[1], v[2], v[3]);
 }
 
+Eigen::Vector3d parse_point(const std::string& text) {
+  const auto v = numbers(text, 3, "task point (x,y,z)");
+  return {v[0], v[1], v[2]};
+}
+
 Joints parse_joints_deg(const std::string& text) {
   const auto v = numbers(text, 6, "start_joints_deg (six angles)");
   Joints q;
@@ -87,7 +93,9 @@ runtime::ComponentInfo RobotComponent::describe() {
       .add_string("model", "ur5e", "arm model", {"ur5e"})
       .add_string("base", "0,0,1.5,180", "where its base stands: x,y,z (m, world; y up) and yaw (deg about the vertical)")
       .add_string("start_joints_deg", "0,-90,90,-90,-90,0", "joint angles at start, degrees")
-      .add_double("rate_hz", 100.0, "control and state rate", 1.0, 1000.0);
+      .add_double("rate_hz", 100.0, "control and state rate", 1.0, 1000.0)
+      .add_string_list("task", {}, "a task of its own: the tool round these points 'x,y,z' (world, m), until a command takes over")
+      .add_double("task_speed", 0.5, "the task's tool speed, m/s (times the speed scale)", 0.01, 1.0);
   return info;
 }
 
@@ -97,9 +105,21 @@ RobotComponent::RobotComponent(runtime::Context& ctx, const runtime::Params& par
       arm_(ArmModel::ur5e(), parse_base(params.get<std::string>("base")),
            parse_joints_deg(params.get<std::string>("start_joints_deg"))),
       rate_hz_(params.get<double>("rate_hz")),
+      task_speed_(params.get<double>("task_speed")),
       state_pub_(ctx, runtime::topics::kRobotState),
       command_sub_(ctx, runtime::topics::kRobotCommand,
-                   [this](const msg::RobotCommand& c, const runtime::SampleMeta&) { on_command(c); }) {}
+                   [this](const msg::RobotCommand& c, const runtime::SampleMeta&) { on_command(c); }) {
+  // From a launch file each item is "x,y,z"; from a command line (-p task=...) the list arrives split at every comma.
+  auto items = params.get<std::vector<std::string>>("task");
+  if (!items.empty() && std::none_of(items.begin(), items.end(), [](const std::string& i) { return i.find(',') != std::string::npos; })) {
+    if (items.size() % 3 != 0) throw std::invalid_argument("task: " + std::to_string(items.size()) + " numbers, not x,y,z triples");
+    std::vector<std::string> joined;
+    for (std::size_t i = 0; i < items.size(); i += 3) joined.push_back(items[i] + "," + items[i + 1] + "," + items[i + 2]);
+    items = joined;
+  }
+  for (const auto& p : items) task_.push_back(parse_point(p));
+  task_active_ = !task_.empty();
+}
 
 void RobotComponent::on_start() {
   last_mono_ns_ = ctx_.clock().monotonic_ns();
@@ -116,8 +136,14 @@ void RobotComponent::on_command(const msg::RobotCommand& c) {
   ++commands_;
   const Eigen::Vector3d target(c.target().x(), c.target().y(), c.target().z());
   switch (c.kind()) {
-    case msg::ROBOT_MOVE_TO: arm_.set_target(target, c.value() > 0 ? c.value() : 0.25); break;
-    case msg::ROBOT_HOLD: arm_.clear_target(); break;
+    case msg::ROBOT_MOVE_TO:
+      task_active_ = false;
+      arm_.set_target(target, c.value() > 0 ? c.value() : 0.25);
+      break;
+    case msg::ROBOT_HOLD:
+      task_active_ = false;
+      arm_.clear_target();
+      break;
     case msg::ROBOT_SPEED_SCALE: arm_.set_speed_scale(c.value()); break;
     case msg::ROBOT_PROTECTIVE_STOP:
       if (!arm_.stopped()) {
@@ -134,6 +160,13 @@ void RobotComponent::step() {
   const auto now = ctx_.clock().monotonic_ns();
   const double dt = std::min(0.1, static_cast<double>(now - last_mono_ns_) * 1e-9);
   last_mono_ns_ = now;
+  if (task_active_) {
+    if ((arm_.tool_world() - task_[task_next_]).norm() < 0.01) {
+      task_next_ = (task_next_ + 1) % task_.size();
+      ++task_points_reached_;
+    }
+    arm_.set_target(task_[task_next_], task_speed_);
+  }
   arm_.step(dt);
   ++steps_;
   if (state_pub_.publish(state_msg(id_, arm_, ctx_.clock().now_ns()))) ++published_;
@@ -151,7 +184,8 @@ nlohmann::json RobotComponent::details() const {
   const auto t = arm_.tool_world();
   return {{"robot_id", id_},   {"model", arm_.model().name}, {"steps", steps_},         {"published", published_},
           {"commands", commands_}, {"ignored", ignored_},     {"protective_stops", stops_},
-          {"stopped", arm_.stopped()}, {"speed_scale", arm_.speed_scale()}, {"tool", {t.x(), t.y(), t.z()}}};
+          {"stopped", arm_.stopped()}, {"speed_scale", arm_.speed_scale()}, {"tool", {t.x(), t.y(), t.z()}},
+          {"task_points_reached", task_points_reached_}};
 }
 
 }  // namespace skelgraph::robot

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "skelgraph/robot/arm.hpp"
 #include "skelgraph/runtime/component.hpp"
@@ -28,7 +29,14 @@ class RobotComponent final : public runtime::Component {
 
   std::string id_;
   ArmSim arm_;
+  // A task of its own: the tool round these points (world) at task_speed, each
+  // next one when the last is reached, until a command takes over.
+  std::vector<Eigen::Vector3d> task_;
+  std::size_t task_next_ = 0;
+  bool task_active_ = false;
+  std::uint64_t task_points_reached_ = 0;
   double rate_hz_;
+  double task_speed_ = 0.5;
   std::int64_t last_mono_ns_ = 0;
   std::uint64_t steps_ = 0, commands_ = 0, stops_ = 0, ignored_ = 0, published_ = 0;
   runtime::Publisher<msg::RobotState> state_pub_;
@@ -36,8 +44,10 @@ class RobotComponent final : public runtime::Component {
   runtime::TimerHandle timer_;
 };
 
-// "x,y,z,yaw_deg" -> base pose; "j1,...,j6" degrees -> joints. Throw std::invalid_argument naming what is wrong.
+// "x,y,z,yaw_deg" -> base pose; "j1,...,j6" degrees -> joints; "x,y,z" -> a point.
+// Throw std::invalid_argument naming what is wrong.
 Eigen::Isometry3d parse_base(const std::string& text);
+Eigen::Vector3d parse_point(const std::string& text);
 Joints parse_joints_deg(const std::string& text);
 // The state message of an arm.
 msg::RobotState state_msg(const std::string& robot_id, const ArmSim& arm, std::int64_t stamp_ns);
