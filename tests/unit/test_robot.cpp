@@ -205,3 +205,21 @@ TEST(Separation, PersonCapsulesComeFromTheReportedJointsWithTheirUncertainty) {
   caps = person_capsules(s);
   EXPECT_EQ(caps.size(), 12u);  // no right forearm, no right hand
 }
+
+TEST(Separation, AStopIsReleasedOnlyAfterTheWayHasBeenClearForAWhile) {
+  StopLatch latch(0.5);
+  SafetyDecision run{SafetyState::Run, 1.0, 0.4, 0.6, "clear"};
+  SafetyDecision stop{SafetyState::ProtectiveStop, 0.0, 0.5, 0.6, "close"};
+  EXPECT_EQ(latch.apply(run, 0.0).state, SafetyState::Run);  // never stopped: no hold
+  EXPECT_EQ(latch.apply(stop, 1.0).state, SafetyState::ProtectiveStop);
+  auto held = latch.apply(run, 1.1);
+  EXPECT_EQ(held.state, SafetyState::ProtectiveStop);
+  EXPECT_EQ(held.speed_scale, 0.0);
+  EXPECT_NE(held.reason.find("holding the stop"), std::string::npos);
+  EXPECT_EQ(latch.apply(run, 1.5).state, SafetyState::ProtectiveStop);
+  EXPECT_EQ(latch.apply(stop, 1.55).state, SafetyState::ProtectiveStop);  // a new stop starts the wait again
+  EXPECT_EQ(latch.apply(run, 1.6).state, SafetyState::ProtectiveStop);
+  EXPECT_EQ(latch.apply(run, 2.05).state, SafetyState::ProtectiveStop);
+  EXPECT_EQ(latch.apply(run, 2.1).state, SafetyState::Run);  // clear for 0.5 s
+  EXPECT_EQ(latch.apply(stop, 2.2).state, SafetyState::ProtectiveStop);  // stopping is never delayed
+}

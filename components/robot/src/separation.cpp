@@ -137,4 +137,29 @@ SafetyDecision decide(const SeparationParams& p, const StoppingModel& stop, cons
   return d;
 }
 
+SafetyDecision StopLatch::apply(SafetyDecision d, double now_s) {
+  if (d.state == SafetyState::ProtectiveStop) {
+    stopped_ = true;
+    clear_ = false;
+    return d;
+  }
+  if (!stopped_) return d;
+  if (!clear_) {
+    clear_ = true;
+    clear_since_s_ = now_s;
+  }
+  if (now_s - clear_since_s_ >= release_s_) {
+    stopped_ = false;
+    return d;
+  }
+  std::ostringstream os;
+  os.setf(std::ios::fixed);
+  os.precision(2);
+  os << "holding the stop until clear for " << release_s_ << " s (" << (now_s - clear_since_s_) << " s so far): " << d.reason;
+  d.state = SafetyState::ProtectiveStop;
+  d.speed_scale = 0;
+  d.reason = os.str();
+  return d;
+}
+
 }  // namespace skelgraph::robot

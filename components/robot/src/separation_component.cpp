@@ -40,6 +40,8 @@ runtime::ComponentInfo SeparationComponent::describe() {
       .add_double("max_robot_age_ms", 100.0, "older robot state: protective stop", 10.0, 10000.0)
       .add_double("person_timeout_ms", 500.0, "a fused person not heard of this long is dropped", 10.0, 10000.0)
       .add_double("sensor_timeout_ms", 500.0, "a sensor without a frame this long is lost", 10.0, 10000.0)
+      .add_double("release_ms", 500.0, "after a stop, the way must be clear this long before the robot moves again",
+                  0.0, 10000.0)
       .add_int("min_sensors", 1, "fewer live sensors than this: protective stop (coverage lost)", 0, 64);
   return info;
 }
@@ -53,6 +55,7 @@ SeparationComponent::SeparationComponent(runtime::Context& ctx, const runtime::P
       person_timeout_s_(params.get<double>("person_timeout_ms") * 1e-3),
       sensor_timeout_s_(params.get<double>("sensor_timeout_ms") * 1e-3),
       min_sensors_(static_cast<int>(params.get<std::int64_t>("min_sensors"))),
+      latch_(params.get<double>("release_ms") * 1e-3),
       safety_pub_(ctx, runtime::topics::kSafety),
       command_pub_(ctx, runtime::topics::kRobotCommand),
       fused_sub_(
@@ -148,7 +151,7 @@ void SeparationComponent::step() {
   }
   in.people_age_s = people_age;
   in.reaction_s = people_age + last_compute_s_ + command_latency_s_;
-  const auto d = decide(params_, stopping_, in);
+  const auto d = latch_.apply(decide(params_, stopping_, in), static_cast<double>(now) * 1e-9);
   last_compute_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (std::isfinite(in.reaction_s)) reaction_ms_.add(in.reaction_s * 1e3);
   ++time_in_[safety_state_name(d.state)];

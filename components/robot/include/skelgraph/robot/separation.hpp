@@ -72,4 +72,20 @@ struct SafetyDecision {
 
 SafetyDecision decide(const SeparationParams& p, const StoppingModel& stop, const SeparationInput& in);
 
+// After a protective stop, the robot stays stopped until the decisions have
+// allowed it to move for `release_s` without a break: a worker walking along
+// the boundary does not start and stop it over and over. Stopping is never
+// delayed. Time passed in.
+class StopLatch {
+ public:
+  explicit StopLatch(double release_s) : release_s_(release_s) {}
+  SafetyDecision apply(SafetyDecision d, double now_s);
+
+ private:
+  double release_s_;
+  bool stopped_ = false;
+  double clear_since_s_ = 0;
+  bool clear_ = false;
+};
+
 }  // namespace skelgraph::robot

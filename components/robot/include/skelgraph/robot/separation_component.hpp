@@ -46,6 +46,7 @@ class SeparationComponent final : public runtime::Component {
   bool have_robot_ = false;
   msg::RobotState robot_;
   std::int64_t robot_received_ns_ = 0;
+  StopLatch latch_;
   SafetyDecision last_;
   bool published_once_ = false;
   std::int64_t last_publish_ns_ = 0;
