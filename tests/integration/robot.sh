@@ -28,7 +28,8 @@ assert r["n"] > 100 and 60 < r["p50"] < 200, r
 rows = [json.loads(l)["data"] for l in open(sys.argv[2])]
 states = {x["state"] for x in rows}
 assert {"PROTECTIVE_STOP"} < states, states
-near = [x for x in rows if x["state"] == "PROTECTIVE_STOP" and x["separation_m"] >= 0]
+near = [x for x in rows if x["state"] == "PROTECTIVE_STOP" and x["separation_m"] is not None and x["separation_m"] >= 0]
+assert all(x["protective_m"] is not None for x in near), [x for x in near if x["protective_m"] is None][:3]
 assert near and all(x["separation_m"] < x["protective_m"] + 0.3 + 1e-6 or "no useful speed" in x["reason"] or "holding the stop" in x["reason"] for x in near), near[:3]
 assert all(x["body_part"] and x["robot_part"] for x in near), near[:3]
 print("ok: robot cell: %s; reaction p50 %.0f ms; %d protective stops" % (by, r["p50"], robot["protective_stops"]))

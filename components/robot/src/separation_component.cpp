@@ -123,9 +123,13 @@ void SeparationComponent::step() {
   in.separation_m = std::numeric_limits<double>::infinity();
   std::uint32_t who = 0;
   std::string body, robot_part;
+  // Nobody there: "nobody" is as old as the last sensor frame; else the
+  // oldest person's capture decides (fused skeletons may come before the
+  // first sensor frame is heard).
   double people_age = newest_frame == std::numeric_limits<std::int64_t>::min()
                           ? std::numeric_limits<double>::infinity()
-                          : static_cast<double>(now - newest_frame) * 1e-9;  // nobody there: as old as the last frame
+                          : static_cast<double>(now - newest_frame) * 1e-9;
+  if (!people_.empty()) people_age = 0;
   for (const auto& [id, p] : people_) {
     if (!skeleton::centre_of(p.s)) {
       in.unplaced_person = true;
