@@ -34,11 +34,14 @@ bool is_arm(JointId j) {
 }
 bool is_hand(JointId j) { return j == JointId::LeftHand || j == JointId::RightHand; }
 
-// Distance between segments p1-q1 and p2-q2 (Ericson, Real-Time Collision Detection, 5.1.9).
-double segment_distance(const Vector3d& p1, const Vector3d& q1, const Vector3d& p2, const Vector3d& q2) {
+// Distance between segments p1-q1 and p2-q2 (Ericson, Real-Time Collision
+// Detection, 5.1.9); `along`: where on p1-q1 the closest point is (0..1).
+double segment_distance(const Vector3d& p1, const Vector3d& q1, const Vector3d& p2, const Vector3d& q2,
+                        double* along = nullptr) {
   const Vector3d d1 = q1 - p1, d2 = q2 - p2, r = p1 - p2;
   const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
   double s = 0, t = 0;
+  if (along) *along = 0;
   if (a <= 1e-12 && e <= 1e-12) return r.norm();
   if (a <= 1e-12) {
     t = std::clamp(f / e, 0.0, 1.0);
@@ -59,6 +62,7 @@ double segment_distance(const Vector3d& p1, const Vector3d& q1, const Vector3d& 
       }
     }
   }
+  if (along) *along = s;
   return ((p1 + d1 * s) - (p2 + d2 * t)).norm();
 }
 
@@ -181,12 +185,13 @@ Visibility visibility(const SensorView& view, const Scene& scene, std::size_t ac
   const Vector3d origin = view.config().position;
   std::vector<std::vector<Capsule>> bodies;
   for (const auto& s : truths) bodies.push_back(capsules(s, body_scale));
-  int sighted = 0, hidden = 0;
+  int sighted = 0, hidden = 0, by_props = 0;
   for (std::size_t j = 0; j < kJointCount; ++j) {
     const Vector3d p = truths[actor].joints[j].position;
     v.in_view[j] = view.in_view(p);
     double depth = 0.0;
     bool blocked = view.blocked(p, scene.obstacles, &depth);
+    if (blocked && j <= idx(JointId::RightHand)) ++by_props;
     v.hit_depth[j] = blocked ? depth : (p - origin).norm();
     // The line of sight, stopped a little short of the joint itself.
     const Vector3d dir = (p - origin).normalized();
@@ -194,9 +199,11 @@ Visibility visibility(const SensorView& view, const Scene& scene, std::size_t ac
     for (std::size_t k = 0; k < bodies.size() && !blocked; ++k) {
       if (k == actor) continue;
       for (const auto& c : bodies[k]) {
-        if (segment_distance(origin, end, c.a, c.b) < c.r) {
+        double s = 0;
+        if (segment_distance(origin, end, c.a, c.b, &s) < c.r) {
           blocked = true;
-          v.hit_depth[j] = std::min(v.hit_depth[j], (c.a - origin).norm());
+          // Where the line of sight passes the other body's limb, on its near surface.
+          v.hit_depth[j] = std::min(v.hit_depth[j], std::max(0.1, s * (end - origin).norm() - c.r));
           break;
         }
       }
@@ -227,6 +234,7 @@ Visibility visibility(const SensorView& view, const Scene& scene, std::size_t ac
   }
   v.sighted_fraction = sighted / static_cast<double>(kJointCount);
   v.object_fraction = hidden / static_cast<double>(idx(JointId::RightHand) + 1);
+  v.prop_fraction = by_props / static_cast<double>(idx(JointId::RightHand) + 1);
   return v;
 }
 
@@ -395,7 +403,7 @@ std::optional<skeleton::Skeleton> TrackerModel::observe(double t, const Scene& s
   // A prop hiding part of the body merges with it in the depth image and
   // drags the fitted skeleton towards itself.
   Vector3d drag = Vector3d::Zero();
-  if (vis.object_fraction > 0.0 && !scene.obstacles.empty()) {
+  if (vis.prop_fraction > 0.0 && !scene.obstacles.empty()) {
     const Vector3d c = truth[JointId::Torso].position;
     double best = 1e9;
     Vector3d nearest = c;
@@ -406,7 +414,7 @@ std::optional<skeleton::Skeleton> TrackerModel::observe(double t, const Scene& s
         nearest = q;
       }
     }
-    if (best < 1.5) drag = p_.contamination * vis.object_fraction * (nearest - c);
+    if (best < 1.5) drag = p_.contamination * vis.prop_fraction * (nearest - c);
   }
 
   skeleton::Skeleton out;

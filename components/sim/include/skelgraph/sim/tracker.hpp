@@ -66,6 +66,7 @@ struct Visibility {
   std::array<double, skeleton::kJointCount> hit_depth{};    // where the line of sight meets the prop (m)
   double sighted_fraction = 0.0;  // in view and not hidden by props or people
   double object_fraction = 0.0;   // share of the upper body (head to hands) hidden by props or people
+  double prop_fraction = 0.0;     // ... by props alone (what drags the fitted skeleton towards a prop)
 };
 
 Visibility visibility(const SensorView& view, const Scene& scene, std::size_t actor,
