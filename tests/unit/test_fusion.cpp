@@ -364,8 +364,9 @@ TEST(Fusion, APersonEverySensorLostIsGoneAtOnceAndDepartsOnce) {
 }
 
 TEST(Fusion, TwoTracksOfOnePersonBecomeOne) {
-  // The sensors' first skeletons disagree by a metre (a tracker starting up),
-  // so each starts its own fused person; once they agree, one person remains,
+  // The sensors' first skeletons disagree by 1.5 m (a tracker starting up:
+  // beyond the 1.2 m a fresh skeleton may join from, and settling over a
+  // second), so each starts its own fused person; once they agree, one person remains,
   // with the first id.
   for (auto m : {fusion::Method::Avg, fusion::Method::Kalman}) {
     auto f = make(m);
@@ -374,7 +375,7 @@ TEST(Fusion, TwoTracksOfOnePersonBecomeOne) {
     for (int k = 0; k < 90; ++k) {
       const std::int64_t t = k * 33 * kMs;
       f.add(in_sensor(person("s1", 1, {0, 1, 0}), kS1), t);
-      f.add(in_sensor(person("s2", 1, k < 3 ? Vector3d(1.0, 1, 0) : Vector3d(0.01, 1, 0)), kS2), t);
+      f.add(in_sensor(person("s2", 1, Vector3d(std::max(0.01, 1.5 - 0.05 * std::max(0, k - 3)), 1, 0)), kS2), t);
       const auto out = f.fuse(t + kMs);
       if (k == 1) first_ticks_people = out.size();
       if (k >= 60) {
@@ -553,6 +554,39 @@ TEST(Fusion, KalmanLeavesOutTheSensorThatSeesAnOccluder) {
   // Into the open between the sensors: in front of both, behind neither.
   EXPECT_EQ(run_ghost(1, Vector3d(0.5, 0, 0.5)).occluded_views, 0u);
   EXPECT_EQ(run_ghost(2, Vector3d(0.5, 0, 0.5)).occluded_views, 0u);
+}
+
+// A tracker that lost its person goes on reporting the last skeleton,
+// unchanged (NITE for seconds): sensor 2's stream freezes where the person
+// was while the person walks on 1.5 m, seen by sensor 1 all along (with the
+// depth noise every live stream has). The fused person follows the person,
+// the frozen skeleton starts no second person, and the id stays.
+TEST(Fusion, KalmanLeavesATrackersFrozenGhostBehind) {
+  auto f = make(fusion::Method::Kalman);
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise(0.0, 0.004);
+  const auto noisy = [&](skeleton::Skeleton s) {
+    for (auto& j : s.joints) j.position += Vector3d(noise(rng), noise(rng), noise(rng));
+    return s;
+  };
+  std::set<std::uint32_t> ids;
+  double worst = 0;
+  skeleton::Skeleton frozen;
+  for (int k = 0; k < 150; ++k) {
+    const std::int64_t t = k * 33 * kMs;
+    const double x = k < 60 ? 0.0 : std::min(1.5, 0.02 * (k - 60));  // walks off at 0.6 m/s from 2 s on
+    const Vector3d at(x, 1, 0);
+    f.add(in_sensor(noisy(person("s1", 1, at)), kS1), t);
+    if (k <= 60) frozen = noisy(person("s2", 7, at));  // from 2 s on, sensor 2 repeats its last skeleton
+    f.add(in_sensor(frozen, kS2), t);
+    const auto out = f.fuse(t + kMs);
+    ASSERT_EQ(out.size(), 1u) << "tick " << k;
+    ids.insert(out[0].person_id);
+    if (k >= 100) worst = std::max(worst, (out[0][JointId::Torso].position - (at + Vector3d(0, 0.2, 0))).norm());
+  }
+  EXPECT_EQ(ids.size(), 1u);
+  EXPECT_LT(worst, 0.1) << "the fused torso stayed with the ghost";
+  EXPECT_GT(f.stats().ghost_views, 30u);
 }
 
 TEST(JointFilter, ConvergesOnAMovingPointAndEstimatesItsVelocity) {
@@ -813,6 +847,61 @@ TEST(Evaluation, IdSwitchesAreCountedAgainstTheTruePerson) {
   EXPECT_EQ(r.streams[0].id_switches, 2u);
   EXPECT_NEAR(r.streams[0].person_seconds, 3.0, 0.1);
   EXPECT_NEAR(r.streams[0].id_switches_per_person_minute(), 40.0, 2.0);
+  EXPECT_EQ(r.streams[0].id_switches_after_gap, 0u);
+}
+
+// A person nobody reports for 1.5 s who comes back under a new id: a switch
+// after a gap (nobody can tell them from someone new without appearance).
+TEST(Evaluation, ASwitchAfterAGapIsCountedApart) {
+  eval::OfflineOptions o;
+  o.methods = {};
+  o.singles = false;
+  eval::Evaluator ev({{"s1", Eigen::Isometry3d::Identity()}}, {"s1"}, {"fused"}, o);
+  for (std::int64_t k = 0; k <= 150; ++k) {
+    const std::int64_t t = 1'000'000'000 + k * 33'333'333;
+    ev.add({eval::TimedSkeleton::Kind::Truth, t, person("truth", 1, {0, 1, 0})});
+    ev.add({eval::TimedSkeleton::Kind::Raw, t + 1, person("s1", 1, {0, 1, 0})});
+    if (k < 45 || k >= 90) ev.add({eval::TimedSkeleton::Kind::Fused, t + 2, person("fused", k < 45 ? 5 : 6, {0, 1, 0})});
+  }
+  const auto r = ev.finish();
+  ASSERT_EQ(r.streams.size(), 1u);
+  EXPECT_EQ(r.streams[0].id_switches, 1u);
+  EXPECT_EQ(r.streams[0].id_switches_after_gap, 1u);
+}
+
+// Several people: each true person is scored on every tick (one without an
+// output is a missed frame), outputs are matched one to one, and a person
+// keeps the output id it had while that output stays within 1 m (the CLEAR
+// MOT rule): two people 0.5 m apart whose outputs both lie between them
+// (each nearer the other person) keep their ids; a third person nobody
+// reports is missed on every tick.
+TEST(Evaluation, EveryTruePersonIsScoredAndKeepsItsOutput) {
+  eval::OfflineOptions o;
+  o.methods = {};
+  o.singles = false;
+  eval::Evaluator ev({{"s1", Eigen::Isometry3d::Identity()}}, {"s1"}, {"fused"}, o);
+  for (std::int64_t k = 0; k <= 90; ++k) {
+    const std::int64_t t = 1'000'000'000 + k * 33'333'333;
+    ev.add({eval::TimedSkeleton::Kind::Truth, t, person("truth", 1, {0, 1, 0})});
+    ev.add({eval::TimedSkeleton::Kind::Truth, t, person("truth", 2, {0.5, 1, 0})});
+    ev.add({eval::TimedSkeleton::Kind::Truth, t, person("truth", 3, {3, 1, 0})});
+    ev.add({eval::TimedSkeleton::Kind::Raw, t + 1, person("s1", 1, {0, 1, 0})});
+    // First each output at its person; from 1 s on both drift inwards past the middle.
+    const double in = k < 30 ? 0.0 : 0.3;
+    ev.add({eval::TimedSkeleton::Kind::Fused, t + 2, person("fused", 11, {in, 1, 0})});
+    ev.add({eval::TimedSkeleton::Kind::Fused, t + 2, person("fused", 12, {0.5 - in, 1, 0})});
+  }
+  const auto r = ev.finish();
+  ASSERT_EQ(r.streams.size(), 1u);
+  const auto& s = r.streams[0];
+  EXPECT_EQ(s.id_switches, 0u);
+  EXPECT_NEAR(s.person_seconds, 6.0, 0.2);  // two people reported for 3 s each
+  // Person 3 is missed on every tick: a third of the person-ticks.
+  const auto torso = s.accuracy.figures()[static_cast<std::size_t>(eval::group_of(JointId::Torso))];
+  EXPECT_NEAR(torso.detection_pct, 100.0 * 2.0 / 3.0, 1.5);
+  // Each output against its own person: 0 cm for 1 s, then 30 cm for 2 s
+  // (against the nearer person it would be 20 cm: a mean of 13 cm).
+  EXPECT_NEAR(torso.error_cm, 20.0, 1.0);
 }
 
 TEST(ArrivalGate, FusesWhenEverySensorsFrameIsWholeInEitherOrder) {

@@ -492,7 +492,8 @@ int eval_sim(const SimEvalOptions& o) {
         const auto& f = r.fuser_stats[i];
         streams.back()["fuser"] = {{"flips_corrected", f.flips_corrected}, {"gated", f.gated},
                                    {"tracks_merged", f.tracks_merged},     {"headings_reversed", f.headings_reversed},
-                                   {"occluded_views", f.occluded_views},   {"fused", f.fused}};
+                                   {"occluded_views", f.occluded_views},   {"ghost_views", f.ghost_views},
+                                   {"fused", f.fused}};
       }
     }
     out.push_back({{"scenario", scenario}, {"sensors", cfg.sensors.size()}, {"profile", cfg.profile},

@@ -126,6 +126,14 @@ std::optional<skeleton::Skeleton> TruthTimeline::at(std::int64_t t_ns, const Eig
   return best;
 }
 
+std::vector<skeleton::Skeleton> TruthTimeline::all_at(std::int64_t t_ns, std::int64_t max_gap_ns) const {
+  std::vector<skeleton::Skeleton> out;
+  for (const auto& [id, v] : by_person_) {
+    if (auto s = interpolate(v, t_ns, max_gap_ns)) out.push_back(std::move(*s));
+  }
+  return out;
+}
+
 void TruthTimeline::forget_before(std::int64_t t_ns) {
   for (auto& [id, v] : by_person_) {
     const auto first_kept = std::lower_bound(v.begin(), v.end(), t_ns, [](const auto& p, std::int64_t x) { return p.first < x; });

@@ -5,7 +5,6 @@
 #include <deque>
 #include <limits>
 #include <optional>
-#include <set>
 #include <stdexcept>
 #include <string>
 
@@ -98,6 +97,7 @@ struct Evaluator::Impl {
     std::string recorded;  // a live fusion component's output id: its recorded skeletons, no fuser
     std::map<std::uint32_t, std::pair<std::int64_t, skeleton::Skeleton>> latest;  // recorded: per person
     std::map<std::uint32_t, std::uint32_t> id_of_truth;  // true person -> the output id it last had
+    std::map<std::uint32_t, std::int64_t> matched_at;    // true person -> when it last had an output
   };
 
   std::map<std::string, Eigen::Isometry3d> poses;
@@ -188,7 +188,10 @@ struct Evaluator::Impl {
                  : std::min(0.1, static_cast<double>(tick - last_scored_tick) * 1e-9);
     last_scored_tick = tick;
     const bool truth_at_use = options.use_delay_ns > 0 && truth.covers(at + options.use_delay_ns);
-    std::vector<bool> complete(lanes.size(), false);  // a skeleton of the lane has the whole upper body at confidence 1
+    const auto people = truth_here ? truth.all_at(at) : std::vector<skeleton::Skeleton>{};
+    // Per lane and true person (or, without truth, per lane): its output has
+    // the whole upper body at confidence 1.
+    std::vector<std::vector<bool>> complete(lanes.size(), std::vector<bool>(std::max<std::size_t>(people.size(), 1), false));
     for (std::size_t i = 0; i < lanes.size(); ++i) {
       auto& lane = lanes[i];
       std::vector<skeleton::Skeleton> fused;
@@ -212,23 +215,63 @@ struct Evaluator::Impl {
       if (!fused.empty()) ++lane.score.with_output;
       for (const auto& f : fused) {
         lane.score.steadiness.add(f);
-        complete[i] = complete[i] || upper_body_complete(f);
+        if (!truth_here) complete[i][0] = complete[i][0] || upper_body_complete(f);
       }
       if (truth_at_use) score_at_use(lane, fused, at + options.use_delay_ns);
       if (!truth_here) continue;
-      score(lane, fused, at);
+      const auto pairs = match(fused, people, lane.id_of_truth);
+      for (const auto& pr : pairs) complete[i][pr.person] = upper_body_complete(fused[pr.output]);
+      score(lane, fused, people, pairs, at);
     }
-    bool any_single = false;
-    for (std::size_t i = 0; i < lanes.size(); ++i) any_single = any_single || (lanes[i].kind == Lane::Kind::Single && complete[i]);
-    if (!any_single) return;
-    for (std::size_t i = 0; i < lanes.size(); ++i) {
-      ++lanes[i].score.ticks_single_complete;
-      if (complete[i]) ++lanes[i].score.complete_when_single;
+    for (std::size_t p = 0; p < complete.front().size() && !lanes.empty(); ++p) {
+      bool any_single = false;
+      for (std::size_t i = 0; i < lanes.size(); ++i) any_single = any_single || (lanes[i].kind == Lane::Kind::Single && complete[i][p]);
+      if (!any_single) continue;
+      for (std::size_t i = 0; i < lanes.size(); ++i) {
+        ++lanes[i].score.ticks_single_complete;
+        if (complete[i][p]) ++lanes[i].score.complete_when_single;
+      }
     }
   }
 
-  // Each true person is scored against the fused person nearest it; a
-  // person nobody reports is a missed frame.
+  // Which output is which true person, one to one, within 1 m (torso to the
+  // output's centre): as in the CLEAR MOT metrics, a person keeps the output
+  // id it had if that output is still within 1 m; the rest pair up closest
+  // first. An output left over is a ghost, a person left over is missed. In
+  // order of distance.
+  struct Pair {
+    std::size_t output, person;
+    double distance;
+  };
+  static std::vector<Pair> match(const std::vector<skeleton::Skeleton>& fused, const std::vector<skeleton::Skeleton>& people,
+                                 const std::map<std::uint32_t, std::uint32_t>& previous) {
+    std::vector<Pair> all;
+    for (std::size_t o = 0; o < fused.size(); ++o) {
+      const auto c = skeleton::centre_of(fused[o]);
+      if (!c) continue;
+      for (std::size_t p = 0; p < people.size(); ++p) {
+        const double d = (people[p][skeleton::JointId::Torso].position - *c).norm();
+        if (d <= 1.0) all.push_back({o, p, d});
+      }
+    }
+    std::stable_sort(all.begin(), all.end(), [](const Pair& a, const Pair& b) { return a.distance < b.distance; });
+    std::vector<Pair> out;
+    std::vector<bool> output_used(fused.size(), false), person_used(people.size(), false);
+    for (const bool kept : {true, false}) {
+      for (const auto& pr : all) {
+        if (output_used[pr.output] || person_used[pr.person]) continue;
+        const auto was = previous.find(people[pr.person].person_id);
+        if (kept && (was == previous.end() || was->second != fused[pr.output].person_id)) continue;
+        output_used[pr.output] = person_used[pr.person] = true;
+        out.push_back(pr);
+      }
+    }
+    std::stable_sort(out.begin(), out.end(), [](const Pair& a, const Pair& b) { return a.distance < b.distance; });
+    return out;
+  }
+
+  // Each true person is scored against the output matched to it (match());
+  // a person without one is a missed frame.
   // At the time of use: each output against where its person is then (the truth nearest it).
   void score_at_use(Lane& lane, const std::vector<skeleton::Skeleton>& fused, std::int64_t at) {
     for (const auto& f : fused) {
@@ -239,38 +282,25 @@ struct Evaluator::Impl {
     }
   }
 
-  void score(Lane& lane, const std::vector<skeleton::Skeleton>& fused, std::int64_t at) {
-    bool scored = false;
+  void score(Lane& lane, const std::vector<skeleton::Skeleton>& fused, const std::vector<skeleton::Skeleton>& people,
+             const std::vector<Pair>& pairs, std::int64_t at) {
     TracePoint tp;
     tp.t_ns = at;
     tp.error_cm.fill(std::nan(""));
-    // The fused person nearest the true one is the person; others are ghosts.
-    std::vector<const skeleton::Skeleton*> order;
-    for (const auto& f : fused) order.push_back(&f);
-    const auto dist = [&](const skeleton::Skeleton* f) {
-      const auto c = skeleton::centre_of(*f);
-      const auto t = c ? truth.at(at, *c) : std::nullopt;
-      return t ? ((*t)[skeleton::JointId::Torso].position - *c).norm() : std::numeric_limits<double>::infinity();
-    };
-    std::stable_sort(order.begin(), order.end(), [&](auto* a, auto* b) { return dist(a) < dist(b); });
-    std::set<std::uint32_t> people_seen;  // true people given their nearest output this tick
-    for (const auto* fp : order) {
-      const auto& f = *fp;
-      const auto c = skeleton::centre_of(f);
-      if (!c) continue;
-      const auto t = truth.at(at, *c);
-      if (!t || ((*t)[skeleton::JointId::Torso].position - *c).norm() > 1.0) continue;  // a ghost, not the person
-      if (people_seen.insert(t->person_id).second) {
-        const auto [was, first] = lane.id_of_truth.try_emplace(t->person_id, f.person_id);
-        if (!first && was->second != f.person_id) {
-          ++lane.score.id_switches;
-          was->second = f.person_id;
-        }
-        lane.score.person_seconds += tick_s;
+    bool traced = false;  // the trace follows the closest pair
+    for (const auto& pr : pairs) {
+      const auto& f = fused[pr.output];
+      const auto* t = &people[pr.person];
+      const auto [was, first] = lane.id_of_truth.try_emplace(t->person_id, f.person_id);
+      if (!first && was->second != f.person_id) {
+        ++lane.score.id_switches;
+        if (at - lane.matched_at[t->person_id] > 1'000'000'000) ++lane.score.id_switches_after_gap;
+        was->second = f.person_id;
       }
+      lane.matched_at[t->person_id] = at;
+      lane.score.person_seconds += tick_s;
       lane.score.accuracy.add(f, *t);
       lane.score.uncertainty.add(f, *t);
-      scored = true;
       if (at - first_truth < static_cast<std::int64_t>(options.compensation_s * 1e9)) {
         const auto before = truth.at(at - 100'000'000, (*t)[skeleton::JointId::Torso].position);
         const double speed =
@@ -281,7 +311,8 @@ struct Evaluator::Impl {
         lane.score.compensated.add(lane.offsets.apply(f, *t), *t);
         lane.score.after_calibration.add(f, *t);
       }
-      if (options.trace) {
+      if (options.trace && !traced) {
+        traced = true;
         std::array<double, kGroupCount> sum{}, n{};
         for (std::size_t j = 0; j < skeleton::kJointCount; ++j) {
           const int g = group_of(skeleton::joint_at(j));
@@ -294,9 +325,8 @@ struct Evaluator::Impl {
         if (tj.confidence >= skeleton::kTracked) tp.joint = tj.position;
         tp.truth = (*t)[options.trace_joint].position;
       }
-      break;
     }
-    if (!scored) {
+    for (std::size_t missed = pairs.size(); missed < people.size(); ++missed) {
       lane.score.accuracy.add_missed();
       if (at - first_truth >= static_cast<std::int64_t>(options.compensation_s * 1e9)) {
         lane.score.compensated.add_missed();

@@ -62,6 +62,7 @@ nlohmann::json stream_json(const StreamScore& s) {
           {"ticks", s.ticks},
           {"ticks_with_output", s.with_output},
           {"id_switches", s.id_switches},
+          {"id_switches_after_gap", s.id_switches_after_gap},
           {"id_switches_per_person_minute", num(s.id_switches_per_person_minute())}};
 }
 
@@ -258,7 +259,8 @@ nlohmann::json fuse_recording(const std::string& file, const std::string& out, c
     per[r.streams[i].name] = {{"ticks_with_output", r.streams[i].with_output},
                               {"flips_corrected", r.fuser_stats[i].flips_corrected},
                               {"gated", r.fuser_stats[i].gated},
-                              {"occluded_views", r.fuser_stats[i].occluded_views}};
+                              {"occluded_views", r.fuser_stats[i].occluded_views},
+                              {"ghost_views", r.fuser_stats[i].ghost_views}};
   }
   return {{"in", file},   {"out", out},       {"copied", copied},  {"fused", fused_count},
           {"on_sync_ticks", !in.ticks.empty()}, {"ticks", r.ticks}, {"methods", per}};

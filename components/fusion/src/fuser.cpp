@@ -51,6 +51,14 @@ constexpr double kWalkAt = 0.35, kWalkWeight = 0.3, kWalkMemory = 0.9;
 constexpr double kConfWeight = 0.5, kConfMargin = 0.02;
 constexpr double kBeliefMemory = 0.99, kBeliefMax = 10.0, kReverseAt = 3.0;
 constexpr double kArmMemory = 0.97;
+// A tracker that lost its person may go on reporting the last skeleton for
+// seconds (NITE: 2.5 s and more, sliding onto a wall): the same shape frame
+// after frame, where a tracked person's joints always move against each
+// other by the depth noise. kFrozenFrames samples in a row whose joints moved
+// under kFrozenM (RMS, about the torso) make the stream frozen (kalman).
+constexpr int kFrozenFrames = 4;
+constexpr double kApart = 0.3;  // m between two skeletons' centres: beyond any tracker noise
+constexpr double kFrozenM = 0.002;
 // Per joint (JointId order), the SD (m, per axis) of the trackers' error that
 // neither the filter nor the sensors' spread shows: where a tracker puts a
 // joint against where it is (its joint definitions, its slow biases), shared
@@ -72,6 +80,8 @@ struct Stream {
   std::size_t sensor;
   std::int64_t first_ns = 0;  // its first sample: a tracker's fresh skeleton is still settling
   double arm_confidence = 1.0;  // mean confidence of its arm joints, lately (kArmMemory)
+  int still = 0;                // samples in a row whose shape did not change (kFrozenM)
+  bool frozen() const { return still >= kFrozenFrames; }
   std::deque<Sample> samples;
   std::optional<std::uint32_t> track;
 };
@@ -141,6 +151,22 @@ struct Track {
   skeleton::Skeleton last;  // last output
   std::uint64_t frames = 0;
 };
+
+// RMS over the joints both skeletons have of how far each moved relative to
+// the torso: 0 for the same shape however the whole moved.
+double shape_change(const skeleton::Skeleton& a, const skeleton::Skeleton& b) {
+  const auto& ta = a[JointId::Torso];
+  const auto& tb = b[JointId::Torso];
+  if (ta.confidence <= 0 || tb.confidence <= 0) return std::numeric_limits<double>::infinity();
+  double sum = 0;
+  int n = 0;
+  for (std::size_t j = 0; j < kJointCount; ++j) {
+    if (a.joints[j].confidence <= 0 || b.joints[j].confidence <= 0) continue;
+    sum += ((a.joints[j].position - ta.position) - (b.joints[j].position - tb.position)).squaredNorm();
+    ++n;
+  }
+  return n > 1 ? std::sqrt(sum / (n - 1)) : std::numeric_limits<double>::infinity();
+}
 
 // The way the torso faces, from the shoulders as this view labels them (horizontal, unit), if it has them.
 std::optional<Vector3d> claimed_heading(const skeleton::Skeleton& s) { return skeleton::claimed_facing(s, Vector3d::UnitY()); }
@@ -237,7 +263,9 @@ struct Fuser::Impl {
     }
     for (View* v : open) {
       Track* best = nullptr;
-      double best_d = opt.match_distance_m;
+      // A tracker's fresh skeleton is tens of centimetres off, more when it
+      // slides back from where it lost the person: it may join from further.
+      double best_d = t - v->stream->first_ns < kSettledNs ? 2 * opt.match_distance_m : opt.match_distance_m;
       for (auto& tr : tracks) {
         if (taken(tr.id, v->sensor)) continue;
         // Compare with where the person is now if another sensor already placed it this round.
@@ -262,6 +290,46 @@ struct Fuser::Impl {
       by_track[best->id].push_back(v);
     }
     return by_track;
+  }
+
+  // A frozen view stays with the person its stream belonged to, left out (as
+  // a ghost on an occluder is) when the other sensors place that person
+  // kApart or more from it; otherwise it joins the nearest person without a
+  // view of its sensor within kApart of where they are now, or none.
+  void join_if_in_place(View& v, std::map<std::uint32_t, std::vector<View*>>& by_track) {
+    const auto has_sensor = [&](const std::vector<View*>& vs) {
+      return std::any_of(vs.begin(), vs.end(), [&](const View* u) { return u->sensor == v.sensor; });
+    };
+    if (v.stream->track && has_track(*v.stream->track)) {
+      auto& vs = by_track[*v.stream->track];
+      if (!has_sensor(vs)) {
+        if (!vs.empty() && (vs.front()->centre - v.centre).norm() >= kApart) {
+          v.occluded = true;
+          ++stats.ghost_views;
+        }
+        vs.push_back(&v);
+        return;
+      }
+    }
+    Track* best = nullptr;
+    double best_d = kApart;
+    for (auto& tr : tracks) {
+      const auto it = by_track.find(tr.id);
+      const bool here = it != by_track.end() && !it->second.empty();
+      if (here && has_sensor(it->second)) continue;
+      const Vector3d c = here ? it->second.front()->centre : tr.centre;
+      const double d = (c - v.centre).norm();
+      if (d < best_d) {
+        best_d = d;
+        best = &tr;
+      }
+    }
+    if (best == nullptr) {
+      ++stats.ghost_views;
+      return;
+    }
+    v.stream->track = best->id;
+    by_track[best->id].push_back(&v);
   }
 
   // Evidence that the person faces `h` rather than the reverse (a log-odds),
@@ -448,7 +516,6 @@ struct Fuser::Impl {
   // while either stream is under a second old (a tracker that has just found
   // someone places them tens of centimetres off for a while, either way).
   void mark_occluded(std::vector<View*>& vs, std::int64_t t) {
-    constexpr double kApart = 0.3;  // m between the skeletons' centres: beyond any tracker noise
     const auto settled = [&](const View& v) { return t - v.stream->first_ns >= kSettledNs; };
     const auto behind = [&](const View& v, const View& u) {  // u hidden behind v from v's sensor
       const Vector3d ray = (v.centre - sensor_position(v.sensor)).normalized();
@@ -468,7 +535,7 @@ struct Fuser::Impl {
     }
     for (std::size_t a = 0; a < vs.size(); ++a) {
       for (std::size_t b = 0; b < vs.size(); ++b) {
-        if (!suspect[b] && against(*vs[a], *vs[b])) vs[a]->occluded = true;
+        if (!suspect[b] && !vs[b]->occluded && against(*vs[a], *vs[b])) vs[a]->occluded = true;
       }
     }
     for (const View* v : vs) stats.occluded_views += v->occluded ? 1 : 0;
@@ -639,7 +706,25 @@ struct Fuser::Impl {
       if (!c) continue;
       views.push_back({&st, key.first, std::move(*s), *c});
     }
+    // kalman: frozen streams (a tracker's ghost of a person it lost) start
+    // no person and count only where the other sensors still place their
+    // person (else the person walked on: the frozen skeleton is left behind).
+    // When every view is frozen (a still scene without tracker noise, as a
+    // synthetic one), that says nothing: they are all used as they are.
+    std::vector<View> frozen;
+    const bool any_live = std::any_of(views.begin(), views.end(), [](const View& v) { return !v.stream->frozen(); });
+    if (opt.method == Method::Kalman && any_live) {
+      for (auto it = views.begin(); it != views.end();) {
+        if (it->stream->frozen()) {
+          frozen.push_back(std::move(*it));
+          it = views.erase(it);
+        } else {
+          ++it;
+        }
+      }
+    }
     auto by_track = associate(views, t);
+    for (auto& v : frozen) join_if_in_place(v, by_track);
     std::vector<skeleton::Skeleton> out;
     ++frame_number;
     for (auto& [id, vs] : by_track) {
@@ -748,6 +833,11 @@ void Fuser::add(const skeleton::Skeleton& raw, std::int64_t t_ns) {
     arms += raw[j].confidence;
   }
   st.arm_confidence = kArmMemory * st.arm_confidence + (1 - kArmMemory) * arms / 6;
+  if (!st.samples.empty() && pos == st.samples.end() && t_ns - st.samples.back().t <= impl_->opt.max_age_ns) {
+    st.still = shape_change(st.samples.back().world, s.world) < kFrozenM ? st.still + 1 : 0;
+  } else if (pos == st.samples.end()) {
+    st.still = 0;
+  }
   st.samples.insert(pos, std::move(s));
   while (st.samples.size() > kHistory) st.samples.pop_front();
   ++impl_->stats.added;

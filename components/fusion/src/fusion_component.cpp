@@ -275,6 +275,7 @@ nlohmann::json FusionComponent::details() const {
           {"flips_corrected", st.flips_corrected},
           {"gated", st.gated},
           {"occluded_views", st.occluded_views},
+          {"ghost_views", st.ghost_views},
           {"tracks_merged", st.tracks_merged}};
 }
 

@@ -82,6 +82,8 @@ class TruthTimeline {
   // within max_gap_ns (or is that close to it).
   std::optional<skeleton::Skeleton> at(std::int64_t t_ns, const Eigen::Vector3d& near,
                                        std::int64_t max_gap_ns = 100'000'000) const;
+  // Every person whose truth covers t (interpolated), in person-id order.
+  std::vector<skeleton::Skeleton> all_at(std::int64_t t_ns, std::int64_t max_gap_ns = 100'000'000) const;
   std::size_t people() const { return by_person_.size(); }
   // True when some person's truth covers t.
   bool covers(std::int64_t t_ns, std::int64_t max_gap_ns = 100'000'000) const;

@@ -69,17 +69,25 @@ struct StreamScore {
   Steadiness steadiness;
   UncertaintyCheck uncertainty;   // against truth, the joints that carry a covariance (kalman)
   std::uint64_t ticks = 0, with_output = 0;
-  // Identity: times a true person's nearest output (within 1 m) carried
-  // another person id than the last output that person had; and the
-  // seconds true people had an output, summed over people.
+  // Outputs are matched to true people one to one, closest pairs first
+  // (torso within 1 m); every true person in the truth counts on every tick
+  // (a person without a matched output is a missed frame in `accuracy`).
+  // Identity: times a true person's matched output carried another person
+  // id than the last output that person had; and the seconds true people
+  // had an output, summed over people.
   std::uint64_t id_switches = 0;
+  // ... of them, switches after the person had had no output for over a
+  // second (hidden from every sensor, or outside their view: without
+  // appearance, nobody can tell it is the same person)
+  std::uint64_t id_switches_after_gap = 0;
   double person_seconds = 0;
   double id_switches_per_person_minute() const {
     return person_seconds > 0 ? 60.0 * static_cast<double>(id_switches) / person_seconds : std::nan("");
   }
-  // Ticks on which some single sensor had the whole upper body at confidence
-  // 1, and of those, the ticks this stream had it too: how much of what any
-  // one sensor tracks the stream keeps.
+  // Person-ticks (with truth: each true person on each tick, its matched
+  // output; without: each tick, any output) on which some single sensor had
+  // the whole upper body at confidence 1, and of those, the ones this stream
+  // had it too: how much of what any one sensor tracks the stream keeps.
   std::uint64_t ticks_single_complete = 0, complete_when_single = 0;
   double complete_when_single_pct() const {
     return ticks_single_complete > 0 ? 100.0 * static_cast<double>(complete_when_single) / static_cast<double>(ticks_single_complete) : 0.0;

@@ -79,6 +79,10 @@ struct FuserStats {
   // kalman: views left out because they disagreed with another sensor's and
   // lay in front of it along their own line of sight (on an occluder: a ghost)
   std::uint64_t occluded_views = 0;
+  // kalman: views of a frozen stream (the same skeleton shape frame after
+  // frame: a tracker's ghost of a person it lost) left out because no person
+  // was within 0.3 m of them
+  std::uint64_t ghost_views = 0;
 };
 
 class Fuser {
