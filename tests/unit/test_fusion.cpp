@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
 #include <random>
 #include <stdexcept>
 #include <set>
@@ -361,6 +362,40 @@ TEST(Fusion, APersonEverySensorLostIsGoneAtOnceAndDepartsOnce) {
     f.fuse(t);
   }
   EXPECT_EQ(f.take_departed(), std::vector<std::uint32_t>{b});
+}
+
+// Two people walk past each other 40 cm apart at 0.6 m/s, seen by both
+// sensors; with `swap`, sensor 2's tracker swaps their user ids as they pass
+// (trackers do, when two people merge in the depth image). Each fused person
+// stays with its true person throughout.
+TEST(Fusion, CrossingPeopleKeepTheirFusedIds) {
+  for (const bool swap : {false, true}) {
+    for (auto m : {fusion::Method::Avg, fusion::Method::Kalman}) {
+      auto f = make(m);
+      std::map<std::uint32_t, int> who;  // fused id -> the true person (0: A, 1: B) it started as
+      int wrong = 0;
+      for (int k = 0; k < 150; ++k) {
+        const std::int64_t t = k * 33 * kMs;
+        const double x = -1.5 + 0.02 * k;  // A walks +x, B -x; they pass at k = 75
+        const Vector3d a(x, 1, 0), b(-x, 1, 0.4);
+        const bool swapped = swap && k >= 75;
+        f.add(in_sensor(person("s1", 1, a), kS1), t);
+        f.add(in_sensor(person("s1", 2, b), kS1), t);
+        f.add(in_sensor(person("s2", swapped ? 2 : 1, a), kS2), t);
+        f.add(in_sensor(person("s2", swapped ? 1 : 2, b), kS2), t);
+        const auto out = f.fuse(t + kMs);
+        ASSERT_EQ(out.size(), 2u) << "tick " << k << (swap ? " (swapped)" : "");
+        for (const auto& p : out) {
+          const Vector3d c = p[JointId::Torso].position - Vector3d(0, 0.2, 0);
+          const int truly = (c - a).norm() < (c - b).norm() ? 0 : 1;
+          const auto [it, first] = who.try_emplace(p.person_id, truly);
+          if (it->second != truly) ++wrong;
+        }
+      }
+      EXPECT_EQ(who.size(), 2u) << (swap ? "swapped ids" : "steady ids");
+      EXPECT_EQ(wrong, 0) << (swap ? "swapped ids" : "steady ids");
+    }
+  }
 }
 
 TEST(Fusion, TwoTracksOfOnePersonBecomeOne) {

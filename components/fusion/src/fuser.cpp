@@ -6,6 +6,7 @@
 #include <deque>
 #include <functional>
 #include <limits>
+#include <set>
 #include <utility>
 
 #include "skelgraph/fusion/joint_filter.hpp"
@@ -57,7 +58,9 @@ constexpr double kArmMemory = 0.97;
 // other by the depth noise. kFrozenFrames samples in a row whose joints moved
 // under kFrozenM (RMS, about the torso) make the stream frozen (kalman).
 constexpr int kFrozenFrames = 4;
-constexpr double kApart = 0.3;  // m between two skeletons' centres: beyond any tracker noise
+constexpr double kApart = 0.3;
+constexpr double kStickM = 0.15;  // a stream's own person counts this much nearer (associate)
+constexpr std::int64_t kPredictNs = 300'000'000;  // m between two skeletons' centres: beyond any tracker noise
 constexpr double kFrozenM = 0.002;
 // Per joint (JointId order), the SD (m, per axis) of the trackers' error that
 // neither the filter nor the sensors' spread shows: where a tracker puts a
@@ -226,9 +229,17 @@ struct Fuser::Impl {
     return std::any_of(tracks.begin(), tracks.end(), [&](const Track& t) { return t.id == id; });
   }
 
-  // Assigns each view to a fused person: the one its stream belonged to if it
-  // is still close, else the nearest without a view from the same sensor,
-  // else a new one.
+  // Where the person is expected at t: the last place moved on by the
+  // walking velocity (for at most kPredictNs).
+  static Vector3d predicted_centre(const Track& tr, std::int64_t t) {
+    const double dt = static_cast<double>(std::clamp<std::int64_t>(t - tr.last_ns, 0, kPredictNs)) * 1e-9;
+    return tr.centre + dt * tr.velocity;
+  }
+
+  // Assigns each view to a fused person: the one whose predicted place is
+  // nearest among those near enough (its stream's own person counting a
+  // little nearer), else, for a new stream, the nearest without a view from
+  // the same sensor, else a new one.
   std::map<std::uint32_t, std::vector<View*>> associate(std::vector<View>& views, std::int64_t t) {
     std::map<std::uint32_t, std::vector<View*>> by_track;
     auto taken = [&](std::uint32_t id, std::size_t sensor) {
@@ -254,13 +265,45 @@ struct Fuser::Impl {
           }
         }
       }
-      if (bound && has_track(*bound) && !taken(*bound, v.sensor) &&
-          (track_by_id(*bound).centre - v.centre).norm() < 2 * opt.match_distance_m) {
-        by_track[*bound].push_back(&v);
-      } else {
-        open.push_back(&v);
+    }
+    // Views of streams that belong to someone go to the person whose
+    // predicted place is nearest, one view per sensor and person, the closest
+    // pairs first; its own person counts kStickM nearer and may be up to
+    // twice match_distance_m away, another at most match_distance_m, and only
+    // once its own is kApart or more away: a tracker's ids are kept unless
+    // another person is clearly nearer (trackers swap ids when people pass
+    // close to each other).
+    struct Candidate {
+      View* v;
+      std::uint32_t track;
+      double cost;
+    };
+    std::vector<Candidate> candidates;
+    for (auto& v : views) {
+      const auto& bound = v.stream->track;
+      if (!bound || !has_track(*bound)) continue;
+      const double d_own = (predicted_centre(track_by_id(*bound), t) - v.centre).norm();
+      for (const auto& tr : tracks) {
+        const bool own = tr.id == *bound;
+        const double d = own ? d_own : (predicted_centre(tr, t) - v.centre).norm();
+        if (own ? d < 2 * opt.match_distance_m : d < opt.match_distance_m && d_own >= kApart)
+          candidates.push_back({&v, tr.id, own ? d - kStickM : d});
       }
     }
+    std::stable_sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) { return a.cost < b.cost; });
+    std::set<const View*> placed;
+    for (const auto& c : candidates) {
+      if (placed.count(c.v) > 0 || taken(c.track, c.v->sensor)) continue;
+      c.v->stream->track = c.track;
+      by_track[c.track].push_back(c.v);
+      placed.insert(c.v);
+    }
+    for (auto& v : views) {
+      if (placed.count(&v) == 0) open.push_back(&v);
+    }
+    // Each person's views in the order of the streams, new streams' after
+    // (the heading's first claim is the first view's).
+    for (auto& [id, vs] : by_track) std::sort(vs.begin(), vs.end());
     for (View* v : open) {
       Track* best = nullptr;
       // A tracker's fresh skeleton is tens of centimetres off, more when it
