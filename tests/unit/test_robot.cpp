@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 
+#include "skelgraph/eval/safety.hpp"
 #include "skelgraph/robot/arm.hpp"
 #include "skelgraph/robot/capsule.hpp"
 #include "skelgraph/robot/separation.hpp"
@@ -222,4 +223,58 @@ TEST(Separation, AStopIsReleasedOnlyAfterTheWayHasBeenClearForAWhile) {
   EXPECT_EQ(latch.apply(run, 2.05).state, SafetyState::ProtectiveStop);
   EXPECT_EQ(latch.apply(run, 2.1).state, SafetyState::Run);  // clear for 0.5 s
   EXPECT_EQ(latch.apply(stop, 2.2).state, SafetyState::ProtectiveStop);  // stopping is never delayed
+}
+
+// Closed loop on the simulated robot cell, judged against the truth
+// (eval/safety.hpp): a worker watched from four sides walks up to the arm,
+// reaches in and walks past. The arm works, is stopped when the worker
+// comes close, and is never allowed to move while the truth says it is too
+// close for its speed.
+namespace {
+skelgraph::eval::SafetyRunOptions robot_cell(int repeats) {
+  skelgraph::eval::SafetyRunOptions o;
+  o.sim.scenario.name = "robot";
+  o.sim.scenario.repeats = repeats;
+  o.sim.sensors = skelgraph::sim::layout_sensors("ring", 4);
+  o.world_from_base = base_pose(0.0, 0.0, 1.9, 180.0);
+  o.task = {{0.45, 0.6, 1.5}, {-0.45, 0.6, 1.5}, {-0.3, 0.3, 1.35}, {0.3, 0.3, 1.35}};
+  return o;
+}
+}  // namespace
+
+TEST(SafetyRun, AWorkerWatchedFromFourSidesIsNeverTooCloseToAMovingArm) {
+  const auto r = skelgraph::eval::run_safety(robot_cell(2));
+  EXPECT_GT(r.seconds, 25.0);
+  EXPECT_GT(r.task_points_reached, 0u);
+  const auto moving = [&](const char* state) { return r.steps_by_state.count(state) ? r.steps_by_state.at(state) : 0u; };
+  EXPECT_GT(moving("RUN") + moving("REDUCED"), 100u);  // the arm works
+  EXPECT_GT(r.stops, 0u);
+  EXPECT_GT(r.intrusions, 0u);  // the worker does come within S_p of the arm
+  EXPECT_EQ(r.missed_steps, 0u);
+  ASSERT_FALSE(r.reaction_ms.empty());
+  // The reaction time is the data's age (the trackers' 50 ms in it) plus the command latency.
+  EXPECT_GT(skelgraph::eval::quantile(r.reaction_ms, 0.5), 60.0);
+  EXPECT_LT(r.min_true_separation_m, 0.5);
+}
+
+// The judge can fail: a monitor whose commands take a second to act, with
+// neither the position uncertainty nor the release hold, lets the arm move
+// while the worker is too close, and its stops come late.
+TEST(SafetyRun, TheJudgeCatchesASlowMonitor) {
+  auto o = robot_cell(2);
+  o.command_latency_s = 1.0;
+  o.uncertainty_scale = 0.0;
+  o.release_s = 0.0;
+  const auto r = skelgraph::eval::run_safety(o);
+  EXPECT_GT(r.missed_steps, 10u);
+  EXPECT_GT(skelgraph::eval::quantile(r.time_to_stop_ms, 1.0), 100.0);
+}
+
+TEST(SafetyRun, QuantilesAndBadConfigurations) {
+  EXPECT_EQ(skelgraph::eval::quantile({}, 0.5), 0.0);
+  EXPECT_EQ(skelgraph::eval::quantile({3, 1, 2, 4}, 0.5), 2.0);
+  EXPECT_EQ(skelgraph::eval::quantile({3, 1, 2, 4}, 1.0), 4.0);
+  auto o = robot_cell(1);
+  o.task.clear();
+  EXPECT_THROW(skelgraph::eval::run_safety(o), std::invalid_argument);
 }

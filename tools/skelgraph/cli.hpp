@@ -84,6 +84,8 @@ void add_bag_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_eval_command(CLI::App& app, GlobalOptions& g, Action& run);
 // `eval presence`, added by add_eval_command.
 void add_eval_presence_command(CLI::App& eval, GlobalOptions& g, Action& run);
+// `eval safety`, added by add_eval_command.
+void add_eval_safety_command(CLI::App& eval, Action& run);
 void add_fuse_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_calib_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_gesture_command(CLI::App& app, GlobalOptions& g, Action& run);

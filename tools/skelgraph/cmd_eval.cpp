@@ -642,6 +642,7 @@ void add_eval_command(CLI::App& app, GlobalOptions& g, Action& run) {
   add_dds_options(*l, g);
   l->callback([lo, &g, &run] { run = [lo, &g] { return eval_live(*lo, g); }; });
   add_eval_presence_command(*ev, g, run);
+  add_eval_safety_command(*ev, run);
 }
 
 }  // namespace skelgraph::cli

@@ -1,6 +1,7 @@
 #include "skelgraph/sim/scenario.hpp"
 
 #include <algorithm>
+#include <optional>
 #include <cmath>
 #include <stdexcept>
 
@@ -243,6 +244,35 @@ void script_point(Builder& b, Rng& rng) {
   b.hold(1.0, "rest");
 }
 
+// robot: a worker at the origin facing an arm 1.9 m ahead (bringup/robot_cell.yaml's
+// base), who walks up to it, reaches into its workspace, backs off, walks
+// past in front of it and comes back. Phases: rest, approach, reach, leave,
+// pass, return (the walking ones with a gait).
+void script_robot(Builder& b) {
+  const BodyPose rest = b.cur;
+  const auto walk_to = [&](Eigen::Vector2d where, double speed, const std::string& phase, std::optional<double> heading = {}) {
+    BodyPose p = b.cur;
+    const double d = (where - p.floor_position).norm();
+    p.heading = heading ? *heading : heading_towards(p.floor_position, where);
+    b.to(p, 0.4, phase);
+    p.floor_position = where;
+    b.to(p, std::max(0.3, d / speed), phase, true);
+  };
+  b.hold(2.0, "rest");
+  walk_to({0.0, b.rng.uniform(0.8, 0.95)}, b.rng.uniform(0.8, 1.2), "approach", rest.heading);
+  const ArmPose reach{deg(b.rng.uniform(75.0, 95.0)), deg(b.rng.uniform(-10.0, 10.0)), b.rng.uniform(0.0, 0.3), 0.0};
+  b.to(with_arms(b.cur, reach, reach), b.rng.uniform(0.6, 0.9), "reach");
+  b.hold(b.rng.uniform(1.0, 2.0), "reach");
+  b.to(with_arms(b.cur, arm_rest(), arm_rest()), 0.8, "reach");
+  walk_to({0.0, -0.2}, 0.8, "leave", rest.heading);
+  walk_to({-1.4, 0.9}, b.rng.uniform(1.0, 1.3), "pass");
+  walk_to({1.4, b.rng.uniform(0.8, 1.1)}, b.rng.uniform(1.0, 1.5), "pass");
+  walk_to({0.0, 0.0}, b.rng.uniform(1.0, 1.3), "return");
+  BodyPose p = b.cur;
+  p.heading = rest.heading;
+  b.to(p, 0.8, "rest");
+}
+
 constexpr double kWalkRadius = 0.5;
 // tour: a wider circle, facing where they go (a calibration walk: every sensor sees the front and the back).
 constexpr double kTourRadius = 0.8;
@@ -305,7 +335,8 @@ BodyPose interpolate(const BodyPose& a, const BodyPose& b, double u) {
 }
 
 const std::vector<std::string>& scenario_names() {
-  static const std::vector<std::string> names{"walk", "360", "hide", "box", "occ", "sit", "arms", "point", "shift", "tour"};
+  static const std::vector<std::string> names{"walk", "360",   "hide",  "box",  "occ",  "sit",
+                                              "arms", "point", "shift", "tour", "robot"};
   return names;
 }
 
@@ -348,6 +379,8 @@ Scenario::Scenario(const ScenarioOptions& options) : opt_(options) {
       script_sit(b, hip_height);
     } else if (n == "arms") {
       script_arms(b);
+    } else if (n == "robot") {
+      script_robot(b);
     } else {
       script_point(b, rng);
     }
@@ -496,6 +529,8 @@ Scene Scenario::at(double t) const {
                                          first.pose.floor_position + Eigen::Vector2d(std::cos(a), std::sin(a)));
     gait(first.pose, 2 * kPi * 0.9 * t);
     first.phase = "walk";
+  } else if (opt_.name == "robot" && first.phase != "rest" && first.phase != "reach") {
+    gait(first.pose, 2 * kPi * 0.9 * t);
   }
   scene.actors.push_back(first);
   // Others walk a wide circle through the cell, facing where they go.

@@ -47,7 +47,11 @@ struct ScenarioOptions {
   Eigen::Vector2d facing{0.0, 2.0};
 };
 
-// walk, 360, hide, box, occ, sit, arms, point, shift.
+// walk, 360, hide, box, occ, sit, arms, point, shift, tour, robot.
+//
+// robot: a worker facing an arm 1.9 m ahead walks up to it, reaches into its
+// workspace, backs off, walks past in front of it and comes back (with
+// `people` 2, a second worker walks a 1.3 m circle through the arm's reach).
 //
 // shift: a working day in the cell. `people` places around the cell centre
 // are each taken by `repeats` people in turn (people * repeats different

@@ -1,0 +1,77 @@
+#pragma once
+// Speed-and-separation monitoring judged against the truth, offline and
+// closed-loop: the simulator's sensors feed the fuser, the `separation`
+// core decides on the fused people (its reaction time measured from their
+// capture stamps, as live), the simulated arm obeys after a command latency,
+// and at every decision the simulator's true people are compared with where
+// the arm really is. DDS-free and deterministic (time is the simulation's);
+// `skelgraph eval safety` runs it.
+//
+// Judged at every decision (ISO/TS 15066 S_p with the truth: the true
+// separation, the arm's true tool speed, the reaction time the system had
+// then, no position uncertainty):
+//  - missed: the true separation is below the true S_p while the state is
+//    RUN or REDUCED (the robot was allowed to move, too fast for the truth);
+//  - an intrusion starts where a missed step follows one that was not, or
+//    where the true separation drops below the true S_p while the robot is
+//    allowed to move; its time to stop runs from the intrusion's start to the
+//    first PROTECTIVE_STOP decision (0 if it never let the robot move);
+//  - unnecessary: PROTECTIVE_STOP while the truth leaves room for a useful
+//    speed (the true separation at least S_p at min_scale times the asked
+//    speed, plus 0.3 m).
+
+#include <array>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "skelgraph/fusion/fuser.hpp"
+#include "skelgraph/robot/separation.hpp"
+#include "skelgraph/sim/simulation.hpp"
+
+namespace skelgraph::eval {
+
+struct SafetyRunOptions {
+  sim::SimConfig sim;               // scenario, seed, sensors; frames are always emitted
+  fusion::FuserOptions fuser;       // the fusion method etc.
+  std::int64_t capture_latency_ns = 50'000'000;  // the trackers' delay (NITE)
+  double fuse_period_s = 1.0 / 30.0;
+  double hop_s = 0.001;             // sensor to fusion
+  // The arm: where it stands and its task (the tool round these points).
+  Eigen::Isometry3d world_from_base = Eigen::Isometry3d::Identity();
+  std::vector<Eigen::Vector3d> task;
+  double task_speed = 0.5;          // m/s, also the speed asked of it (robot_max_speed)
+  robot::SeparationParams params;
+  double release_s = 0.5;
+  double uncertainty_scale = 1.0;   // Z_d: the fused joints' 95 % radius times this (0: left out, to see what it costs)
+  double decision_rate_hz = 100.0;  // decisions and arm steps per second
+  double command_latency_s = 0.01;  // from a decision to the arm acting on it (and in the reaction time)
+  double unnecessary_margin_m = 0.3;
+};
+
+struct SafetyRunResult {
+  double seconds = 0;
+  std::uint64_t steps = 0;
+  std::map<std::string, std::uint64_t> steps_by_state;  // RUN, REDUCED, PROTECTIVE_STOP
+  std::uint64_t missed_steps = 0;       // see above; the target is 0
+  std::uint64_t unnecessary_steps = 0;
+  std::uint64_t stop_steps = 0;
+  std::uint64_t intrusions = 0;         // ... of a robot allowed to move
+  std::vector<double> time_to_stop_ms;  // one per intrusion
+  std::vector<double> reaction_ms;      // the reaction time of every decision with people
+  double min_true_separation_m = 0;     // over the run (+inf: nobody)
+  std::uint64_t task_points_reached = 0;
+  std::uint64_t stops = 0;              // protective stops commanded
+};
+
+// One run of the scenario (sim.scenario, its repeats) from start to end.
+// Throws std::invalid_argument for a bad configuration (an empty task).
+SafetyRunResult run_safety(const SafetyRunOptions& options);
+
+// The quantile q of values (nearest rank); 0 when empty.
+double quantile(std::vector<double> values, double q);
+
+}  // namespace skelgraph::eval

@@ -1,0 +1,191 @@
+#include "skelgraph/eval/safety.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <limits>
+#include <stdexcept>
+
+#include "skelgraph/robot/arm.hpp"
+#include "skelgraph/robot/capsule.hpp"
+
+namespace skelgraph::eval {
+
+double quantile(std::vector<double> values, double q) {
+  if (values.empty()) return 0.0;
+  const auto k = static_cast<std::size_t>(std::clamp(std::ceil(q * static_cast<double>(values.size())) - 1.0, 0.0,
+                                                     static_cast<double>(values.size() - 1)));
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
+  return values[k];
+}
+
+namespace {
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// The closest of `people` to the arm: surface distance, and which capsule (for its uncertainty).
+struct Nearest {
+  double distance = kInf;
+  double uncertainty = 0;
+};
+Nearest nearest(const std::vector<skeleton::Skeleton>& people, const std::vector<robot::Capsule>& arm) {
+  Nearest n;
+  for (const auto& p : people) {
+    std::vector<double> u;
+    const auto caps = robot::person_capsules(p, &u);
+    const auto c = robot::closest(caps, arm);
+    if (c.distance < n.distance) {
+      n.distance = c.distance;
+      n.uncertainty = u.empty() ? 0.0 : u[c.first];
+    }
+  }
+  return n;
+}
+}  // namespace
+
+SafetyRunResult run_safety(const SafetyRunOptions& o) {
+  if (o.task.empty()) throw std::invalid_argument("safety run: the arm needs a task (points for its tool)");
+  if (!(o.decision_rate_hz > 0) || !(o.fuse_period_s > 0))
+    throw std::invalid_argument("safety run: decision rate and fusion period must be positive");
+  auto cfg = o.sim;
+  cfg.emit_frames = true;
+  cfg.emit_departures = true;
+  sim::Simulation sim(cfg);
+  fusion::Fuser fuser(o.fuser);
+  for (const auto& s : cfg.sensors) {
+    fuser.set_pose(s.id, s.world_from_sensor());
+    fuser.set_capture_latency(s.id, o.capture_latency_ns);
+  }
+  robot::Joints start;
+  start << 0.0, -M_PI / 2, M_PI / 2, -M_PI / 2, -M_PI / 2, 0.0;
+  robot::ArmSim arm(robot::ArmModel::ur5e(), o.world_from_base, start);
+  const auto& stopping = arm.model().stopping;
+  robot::StopLatch latch(o.release_s);
+
+  SafetyRunResult r;
+  r.min_true_separation_m = kInf;
+  const double dt = 1.0 / o.decision_rate_hz;
+  const auto steps = static_cast<std::uint64_t>(std::floor(sim.duration() / dt));
+  std::vector<skeleton::Skeleton> people;  // the latest fused output
+  std::int64_t last_frame_ns = std::numeric_limits<std::int64_t>::min();
+  double next_fuse = 0.0;
+  struct Command {
+    double at;
+    robot::SafetyState state;
+    double scale;
+  };
+  std::deque<Command> commands;
+  bool decided_once = false;
+  robot::SafetyDecision last;
+  std::size_t task_next = 0;
+  bool danger_before = false, waiting_for_stop = false;
+  double danger_since = 0.0;
+
+  for (std::uint64_t k = 0; k < steps; ++k) {
+    const double now = static_cast<double>(k) * dt;
+    const std::int64_t now_ns = std::llround(now * 1e9);
+    // What reached fusion by now (a hop after the sensor delivered it).
+    for (auto& e : sim.advance(now - o.hop_s)) {
+      const std::int64_t arrival = std::llround((e.t + o.hop_s) * 1e9);
+      switch (e.kind) {
+        case sim::SimEvent::Kind::Raw: fuser.add(e.skeleton, arrival); break;
+        case sim::SimEvent::Kind::Frame:
+          fuser.heartbeat(e.skeleton.sensor_id, arrival);
+          last_frame_ns = std::max(last_frame_ns, arrival);
+          break;
+        case sim::SimEvent::Kind::Lost: fuser.remove(e.skeleton.sensor_id, e.skeleton.person_id); break;
+        default: break;
+      }
+    }
+    if (now + 1e-12 >= next_fuse) {
+      people = fuser.fuse(now_ns);
+      next_fuse += o.fuse_period_s;
+    }
+
+    // The decision, as the separation component makes it.
+    const auto arm_caps = arm.capsules();
+    robot::SeparationInput in;
+    in.robot_age_s = 0.0;
+    in.robot_speed = arm.tool_speed();
+    in.robot_max_speed = o.task_speed;
+    double age = last_frame_ns == std::numeric_limits<std::int64_t>::min() ? kInf
+                                                                            : static_cast<double>(now_ns - last_frame_ns) * 1e-9;
+    if (!people.empty()) age = 0.0;
+    for (const auto& p : people) {
+      if (!skeleton::centre_of(p)) in.unplaced_person = true;
+      const std::int64_t capture = p.capture_newest_ns != 0 ? p.capture_newest_ns : p.stamp_ns;
+      age = std::max(age, static_cast<double>(now_ns - capture) * 1e-9);
+    }
+    const auto seen = nearest(people, arm_caps);
+    in.separation_m = seen.distance;
+    in.person_uncertainty_m = o.uncertainty_scale * seen.uncertainty;
+    in.closest = "person";
+    in.people_age_s = age;
+    in.reaction_s = age + o.command_latency_s;
+    const auto d = latch.apply(robot::decide(o.params, stopping, in), now);
+    ++r.steps;
+    ++r.steps_by_state[robot::safety_state_name(d.state)];
+    if (!people.empty() && std::isfinite(in.reaction_s)) r.reaction_ms.push_back(in.reaction_s * 1e3);
+    const bool stop = d.state == robot::SafetyState::ProtectiveStop;
+    r.stop_steps += stop ? 1 : 0;
+
+    // Judged against the truth: where the people really are, how fast the arm really moves.
+    const auto truth = nearest(sim.truth_at(now), arm_caps);
+    r.min_true_separation_m = std::min(r.min_true_separation_m, truth.distance);
+    if (std::isfinite(truth.distance) && std::isfinite(in.reaction_s)) {
+      const double sp = robot::protective_distance(o.params, stopping, truth.distance, arm.tool_speed(), in.reaction_s, 0.0);
+      const bool danger = truth.distance < sp;
+      if (danger && !stop) ++r.missed_steps;
+      if (danger && !danger_before) {
+        ++r.intrusions;
+        if (stop) {
+          r.time_to_stop_ms.push_back(0.0);
+        } else {
+          waiting_for_stop = true;
+          danger_since = now;
+        }
+      }
+      if (waiting_for_stop && (stop || !danger)) {
+        r.time_to_stop_ms.push_back((now - danger_since) * 1e3);  // (danger over without a stop: as long as it lasted)
+        waiting_for_stop = false;
+      }
+      danger_before = danger;
+      const double useful = robot::protective_distance(o.params, stopping, truth.distance,
+                                                       o.params.min_scale * o.task_speed, in.reaction_s, 0.0);
+      if (stop && truth.distance >= useful + o.unnecessary_margin_m) ++r.unnecessary_steps;
+    } else {
+      danger_before = false;
+      if (stop && !std::isfinite(truth.distance)) ++r.unnecessary_steps;  // nobody there at all
+    }
+
+    // Commands on change, as the component sends them, acted on after the latency.
+    const bool was_stop = decided_once && last.state == robot::SafetyState::ProtectiveStop;
+    if ((stop && (!decided_once || !was_stop)) ||
+        (!stop && (!decided_once || was_stop || std::abs(d.speed_scale - last.speed_scale) > 0.02))) {
+      commands.push_back({now + o.command_latency_s, d.state, d.speed_scale});
+      if (stop && (!decided_once || !was_stop)) ++r.stops;
+    }
+    decided_once = true;
+    last = d;
+    while (!commands.empty() && commands.front().at <= now + 1e-12) {
+      const auto& c = commands.front();
+      if (c.state == robot::SafetyState::ProtectiveStop) {
+        arm.protective_stop();
+      } else {
+        arm.set_speed_scale(c.scale);
+        if (arm.stopped()) arm.resume();
+      }
+      commands.pop_front();
+    }
+    // The arm's own task.
+    if ((arm.tool_world() - o.task[task_next]).norm() < 0.01) {
+      task_next = (task_next + 1) % o.task.size();
+      ++r.task_points_reached;
+    }
+    arm.set_target(o.task[task_next], o.task_speed);
+    arm.step(dt);
+  }
+  r.seconds = static_cast<double>(r.steps) * dt;
+  return r;
+}
+
+}  // namespace skelgraph::eval
