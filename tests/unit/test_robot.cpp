@@ -193,14 +193,26 @@ TEST(Separation, PersonCapsulesComeFromTheReportedJointsWithTheirUncertainty) {
   s[skeleton::JointId::RightHand].position = Vector3d(0.5, 1.0, 0.2);
   s[skeleton::JointId::RightElbow].position = Vector3d(0.4, 1.1, 0.0);
   skeleton::set_covariance(s[skeleton::JointId::RightHand], Eigen::Matrix3d::Identity() * 0.0004);
-  std::vector<double> u;
-  auto caps = person_capsules(s, &u);
-  ASSERT_EQ(caps.size(), u.size());
+  std::vector<std::vector<skeleton::JointId>> joints;
+  auto caps = person_capsules(s, &joints);
+  ASSERT_EQ(caps.size(), joints.size());
   EXPECT_EQ(caps.size(), 14u);  // 13 parts and the lower trunk
   std::size_t hand = 0;
   while (hand < caps.size() && caps[hand].name != "right_hand") ++hand;
   ASSERT_LT(hand, caps.size());
-  EXPECT_NEAR(u[hand], std::sqrt(7.815 * 0.0004), 1e-9);
+  EXPECT_EQ(joints[hand], (std::vector<skeleton::JointId>{skeleton::JointId::RightHand, skeleton::JointId::RightHand}));
+  // The hand nearest a robot link beside it (+x): Z_d is the hand's 95 %
+  // radius, the ellipsoid's largest axis (10 cm sigma in z).
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  cov.diagonal() << 0.0004, 0.0004, 0.01;
+  skeleton::set_covariance(s[skeleton::JointId::RightHand], cov);
+  const Capsule link{{1.0, 0.5, 0.2}, {1.0, 1.5, 0.2}, 0.05, "forearm"};
+  const auto sep = separation_to(s, {link});
+  EXPECT_EQ(sep.part, "right_hand");
+  EXPECT_EQ(sep.robot_part, "forearm");
+  EXPECT_NEAR(sep.distance, 0.5 - 0.09 - 0.05, 1e-6);
+  EXPECT_NEAR(sep.uncertainty_m, std::sqrt(7.815 * 0.01), 1e-4);
+  EXPECT_TRUE(std::isinf(separation_to(s, {}).distance));
   // A joint not reported takes its parts away.
   s[skeleton::JointId::RightHand].confidence = 0;
   caps = person_capsules(s);

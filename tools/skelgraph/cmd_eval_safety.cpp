@@ -53,7 +53,10 @@ int eval_safety(const SafetyOptions& o) {
   nlohmann::json runs = nlohmann::json::array();
   eval::SafetyRunResult all;
   all.min_true_separation_m = std::numeric_limits<double>::infinity();
-  sim_config(o.params, "eval safety", {{"scenario", "robot"}});  // bad parameters: said before anything runs
+  // Bad parameters are said before anything runs.
+  sim_config(o.params, "eval safety",
+             {{"scenario", "robot", "eval safety"}, {"seed", "1", "--seeds"}, {"people", "1", "--people"},
+              {"repeats", std::to_string(o.repeats), "--repeats"}});
   if (!o.json) std::printf("%-6s %-5s %8s %7s %10s %12s %12s %8s %7s %7s\n", "people", "seed", "minutes", "missed", "intrusions",
                            "to stop p99", "reaction p99", "stop %", "unnec %", "stops");
   for (const int people : o.people) {
@@ -67,8 +70,10 @@ int eval_safety(const SafetyOptions& o) {
       });
       if (!placed) params.insert(params.end(), {"layout=ring", "sensor_count=4"});
       so.sim = sim_config(params, "eval safety",
-                          {{"scenario", "robot"}, {"seed", std::to_string(seed)}, {"people", std::to_string(people)},
-                           {"repeats", std::to_string(o.repeats)}});
+                          {{"scenario", "robot", "eval safety"},
+                           {"seed", std::to_string(seed), "--seeds"},
+                           {"people", std::to_string(people), "--people"},
+                           {"repeats", std::to_string(o.repeats), "--repeats"}});
       so.fuser.method = *method;
       so.capture_latency_ns = std::llround(o.capture_latency_ms * 1e6);
       so.command_latency_s = o.command_latency_ms * 1e-3;

@@ -30,12 +30,10 @@ struct Nearest {
 Nearest nearest(const std::vector<skeleton::Skeleton>& people, const std::vector<robot::Capsule>& arm) {
   Nearest n;
   for (const auto& p : people) {
-    std::vector<double> u;
-    const auto caps = robot::person_capsules(p, &u);
-    const auto c = robot::closest(caps, arm);
+    const auto c = robot::separation_to(p, arm);
     if (c.distance < n.distance) {
       n.distance = c.distance;
-      n.uncertainty = u.empty() ? 0.0 : u[c.first];
+      n.uncertainty = c.uncertainty_m;
     }
   }
   return n;

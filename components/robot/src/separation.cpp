@@ -26,7 +26,7 @@ double protective_distance(const SeparationParams& p, const StoppingModel& stop,
          p.robot_uncertainty_m;
 }
 
-std::vector<Capsule> person_capsules(const skeleton::Skeleton& s, std::vector<double>* uncertainty) {
+std::vector<Capsule> person_capsules(const skeleton::Skeleton& s, std::vector<std::vector<JointId>>* joints) {
   struct Part {
     const char* name;
     JointId a, b;
@@ -48,13 +48,13 @@ std::vector<Capsule> person_capsules(const skeleton::Skeleton& s, std::vector<do
       {"right_shin", JointId::RightKnee, JointId::RightFoot, 0.06},
   };
   std::vector<Capsule> out;
-  if (uncertainty) uncertainty->clear();
+  if (joints) joints->clear();
   for (const auto& part : parts) {
     const auto& a = s[part.a];
     const auto& b = s[part.b];
     if (a.confidence <= 0 || b.confidence <= 0) continue;
     out.push_back({a.position, b.position, part.radius, part.name});
-    if (uncertainty) uncertainty->push_back(std::max(skeleton::radius_95(a), skeleton::radius_95(b)));
+    if (joints) joints->push_back({part.a, part.b});
   }
   // The trunk reaches down to the hips.
   const auto& torso = s[JointId::Torso];
@@ -62,11 +62,21 @@ std::vector<Capsule> person_capsules(const skeleton::Skeleton& s, std::vector<do
   const auto& rh = s[JointId::RightHip];
   if (torso.confidence > 0 && lh.confidence > 0 && rh.confidence > 0) {
     out.push_back({torso.position, 0.5 * (lh.position + rh.position), 0.17, "trunk"});
-    if (uncertainty) {
-      uncertainty->push_back(
-          std::max({skeleton::radius_95(torso), skeleton::radius_95(lh), skeleton::radius_95(rh)}));
-    }
+    if (joints) joints->push_back({JointId::Torso, JointId::LeftHip, JointId::RightHip});
   }
+  return out;
+}
+
+PersonSeparation separation_to(const skeleton::Skeleton& person, const std::vector<Capsule>& robot) {
+  std::vector<std::vector<JointId>> joints;
+  const auto parts = person_capsules(person, &joints);
+  const auto c = closest(parts, robot);
+  PersonSeparation out;
+  out.distance = c.distance;
+  if (!std::isfinite(c.distance)) return out;
+  out.part = parts[c.first].name;
+  out.robot_part = robot[c.second].name;
+  for (const auto j : joints[c.first]) out.uncertainty_m = std::max(out.uncertainty_m, skeleton::radius_95(person[j]));
   return out;
 }
 

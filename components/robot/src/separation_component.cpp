@@ -135,16 +135,14 @@ void SeparationComponent::step() {
       in.unplaced_person = true;
       continue;
     }
-    std::vector<double> u;
-    const auto caps = person_capsules(p.s, &u);
-    const auto c = closest(caps, robot_caps);
+    const auto c = separation_to(p.s, robot_caps);
     const std::int64_t capture = p.s.capture_newest_ns != 0 ? p.s.capture_newest_ns : p.s.stamp_ns;
     if (c.distance < in.separation_m) {
       in.separation_m = c.distance;
-      in.person_uncertainty_m = u[c.first];
+      in.person_uncertainty_m = c.uncertainty_m;
       who = id;
-      body = caps[c.first].name;
-      robot_part = robot_caps[c.second].name;
+      body = c.part;
+      robot_part = c.robot_part;
     }
     people_age = std::max(people_age, static_cast<double>(now - capture) * 1e-9);  // the oldest person decides
   }
