@@ -10,6 +10,7 @@
 #include "skelgraph/eval/safety.hpp"
 #include "skelgraph/robot/arm.hpp"
 #include "skelgraph/robot/capsule.hpp"
+#include "skelgraph/robot/follow.hpp"
 #include "skelgraph/robot/separation.hpp"
 
 using namespace skelgraph;
@@ -289,4 +290,42 @@ TEST(SafetyRun, QuantilesAndBadConfigurations) {
   auto o = robot_cell(1);
   o.task.clear();
   EXPECT_THROW(skelgraph::eval::run_safety(o), std::invalid_argument);
+}
+
+// Following a hand: the tool keeps the standoff on the robot's side of the
+// hand, inside the workspace; it holds without a tracked hand or with old
+// data; it stays with the person it follows while they are there.
+TEST(Follow, TheToolKeepsItsStandoffFromTheHandAndHoldsWithoutOne) {
+  FollowParams p;
+  p.standoff_m = 0.5;
+  p.workspace = Eigen::AlignedBox3d(Vector3d(-1, 0, 0), Vector3d(1, 2, 3));
+  Follower f(p, Vector3d(0, 0, 2));  // the base 2 m ahead of the origin
+  const auto person = [](std::uint32_t id, const Vector3d& hand, std::int64_t captured) {
+    skeleton::Skeleton s;
+    s.person_id = id;
+    for (auto& j : s.joints) j.confidence = skeleton::kTracked;
+    s[skeleton::JointId::RightHand].position = hand;
+    s.capture_newest_ns = captured;
+    return s;
+  };
+  const std::int64_t now = 1'000'000'000;
+  auto t = f.step({person(4, Vector3d(0, 1.2, 0.5), now - 60'000'000)}, now);
+  ASSERT_FALSE(t.hold) << t.reason;
+  EXPECT_EQ(t.person, 4u);
+  EXPECT_TRUE(t.target.isApprox(Vector3d(0, 1.2, 1.0), 1e-9));  // 0.5 m towards the base, at the hand's height
+  // Another person nearer the workspace does not take over while person 4 is there.
+  t = f.step({person(4, Vector3d(0.3, 1.2, 0.5), now - 60'000'000), person(5, Vector3d(0, 1.2, 1.5), now)}, now);
+  EXPECT_EQ(t.person, 4u);
+  // Clamped into the workspace.
+  t = f.step({person(4, Vector3d(0.3, 2.5, 0.5), now)}, now);
+  EXPECT_NEAR(t.target.y(), 2.0, 1e-9);
+  // Holds: data too old, hand not tracked, nobody.
+  EXPECT_TRUE(f.step({person(4, Vector3d(0, 1.2, 0.5), now - 400'000'000)}, now).hold);
+  auto untracked = person(4, Vector3d(0, 1.2, 0.5), now);
+  untracked[skeleton::JointId::RightHand].confidence = skeleton::kInferred;
+  EXPECT_TRUE(f.step({untracked}, now).hold);
+  EXPECT_TRUE(f.step({}, now).hold);
+  // Person 4 gone: the one with a hand nearest the workspace.
+  t = f.step({person(5, Vector3d(0, 1.2, 0.5), now)}, now);
+  EXPECT_EQ(t.person, 5u);
 }

@@ -26,6 +26,8 @@ struct SafetyOptions {
   double capture_latency_ms = 50.0;
   double release_ms = 500.0;
   double uncertainty_scale = 1.0;
+  bool follow = false;
+  double standoff_m = 0.8;
   bool json = false;
 };
 
@@ -44,6 +46,10 @@ nlohmann::json run_json(const eval::SafetyRunResult& r) {
           {"unnecessary_stop_pct", share(r.unnecessary_steps)},
           {"stops", r.stops},
           {"task_points_reached", r.task_points_reached},
+          {"follow",
+           {{"steps", r.follow_steps},
+            {"moving_steps", r.follow_moving_steps},
+            {"error_m", {{"p50", eval::quantile(r.follow_error_m, 0.5)}, {"p95", eval::quantile(r.follow_error_m, 0.95)}}}}},
           {"min_true_separation_m", std::isfinite(r.min_true_separation_m) ? nlohmann::json(r.min_true_separation_m) : nlohmann::json()}};
 }
 
@@ -79,6 +85,10 @@ int eval_safety(const SafetyOptions& o) {
       so.command_latency_s = o.command_latency_ms * 1e-3;
       so.release_s = o.release_ms * 1e-3;
       so.uncertainty_scale = o.uncertainty_scale;
+      if (o.follow) {
+        so.follow.emplace();
+        so.follow->standoff_m = o.standoff_m;
+      }
       // bringup/robot_cell.yaml's arm and task.
       so.world_from_base = robot::base_pose(0.0, 0.0, 1.9, 180.0);
       so.task = {{0.45, 0.6, 1.5}, {-0.45, 0.6, 1.5}, {-0.3, 0.3, 1.35}, {0.3, 0.3, 1.35}};
@@ -104,6 +114,9 @@ int eval_safety(const SafetyOptions& o) {
       all.stop_steps += r.stop_steps;
       all.stops += r.stops;
       all.task_points_reached += r.task_points_reached;
+      all.follow_steps += r.follow_steps;
+      all.follow_moving_steps += r.follow_moving_steps;
+      all.follow_error_m.insert(all.follow_error_m.end(), r.follow_error_m.begin(), r.follow_error_m.end());
       all.min_true_separation_m = std::min(all.min_true_separation_m, r.min_true_separation_m);
       all.time_to_stop_ms.insert(all.time_to_stop_ms.end(), r.time_to_stop_ms.begin(), r.time_to_stop_ms.end());
       all.reaction_ms.insert(all.reaction_ms.end(), r.reaction_ms.begin(), r.reaction_ms.end());
@@ -128,6 +141,13 @@ int eval_safety(const SafetyOptions& o) {
                 eval::quantile(all.time_to_stop_ms, 1.0), eval::quantile(all.reaction_ms, 0.5),
                 eval::quantile(all.reaction_ms, 0.99), total["stop_pct"].get<double>(),
                 total["unnecessary_stop_pct"].get<double>());
+    if (o.follow) {
+      std::printf("follow: a hand to follow %.1f %% of the time, the arm allowed to move %.1f %% of that; tool from where the "
+                  "true hand puts it: median %.2f m, p95 %.2f m\n",
+                  all.steps ? 100.0 * static_cast<double>(all.follow_steps) / static_cast<double>(all.steps) : 0.0,
+                  all.follow_steps ? 100.0 * static_cast<double>(all.follow_moving_steps) / static_cast<double>(all.follow_steps) : 0.0,
+                  eval::quantile(all.follow_error_m, 0.5), eval::quantile(all.follow_error_m, 0.95));
+    }
   }
   return 0;
 }
@@ -153,6 +173,9 @@ void add_eval_safety_command(CLI::App& eval, Action& run) {
   c->add_option("--uncertainty-scale", o->uncertainty_scale,
                 "Z_d is the fused joints' 95 % radius times this (1, as the separation component; 0 leaves it out, to see what it costs)")
       ->check(CLI::Range(0.0, 10.0));
+  c->add_flag("--follow", o->follow, "the arm follows the worker's right hand instead of its task (robot/follow.hpp)");
+  c->add_option("--standoff-m", o->standoff_m, "follow: the tool keeps this far from the hand, on the robot's side")
+      ->check(CLI::Range(0.0, 3.0));
   c->add_flag("--json", o->json, "machine-readable results");
   c->callback([o, &run] { run = [o] { return eval_safety(*o); }; });
 }

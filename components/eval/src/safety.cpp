@@ -41,7 +41,7 @@ Nearest nearest(const std::vector<skeleton::Skeleton>& people, const std::vector
 }  // namespace
 
 SafetyRunResult run_safety(const SafetyRunOptions& o) {
-  if (o.task.empty()) throw std::invalid_argument("safety run: the arm needs a task (points for its tool)");
+  if (o.task.empty() && !o.follow) throw std::invalid_argument("safety run: the arm needs a task (points for its tool) or a hand to follow");
   if (!(o.decision_rate_hz > 0) || !(o.fuse_period_s > 0))
     throw std::invalid_argument("safety run: decision rate and fusion period must be positive");
   auto cfg = o.sim;
@@ -75,6 +75,8 @@ SafetyRunResult run_safety(const SafetyRunOptions& o) {
   bool decided_once = false;
   robot::SafetyDecision last;
   std::size_t task_next = 0;
+  std::optional<robot::Follower> follower;
+  if (o.follow) follower.emplace(*o.follow, o.world_from_base.translation());
   bool danger_before = false, waiting_for_stop = false;
   double danger_since = 0.0;
 
@@ -174,12 +176,42 @@ SafetyRunResult run_safety(const SafetyRunOptions& o) {
       }
       commands.pop_front();
     }
-    // The arm's own task.
-    if ((arm.tool_world() - o.task[task_next]).norm() < 0.01) {
-      task_next = (task_next + 1) % o.task.size();
-      ++r.task_points_reached;
+    if (follower) {
+      // The hand, as fused: where the tool goes; judged against where the true hand would send it.
+      const auto f = follower->step(people, now_ns);
+      if (f.hold) {
+        arm.clear_target();
+      } else {
+        arm.set_target(f.target, o.task_speed);
+        ++r.follow_steps;
+        const auto& fused = *std::find_if(people.begin(), people.end(), [&](const auto& p) { return p.person_id == f.person; });
+        const Eigen::Vector3d seen_hand = fused[o.follow->joint].position;
+        const auto truths = sim.truth_at(now);
+        const skeleton::Skeleton* nearest_truth = nullptr;
+        for (const auto& t : truths) {
+          if (!nearest_truth || (t[o.follow->joint].position - seen_hand).norm() < ((*nearest_truth)[o.follow->joint].position - seen_hand).norm())
+            nearest_truth = &t;
+        }
+        if (nearest_truth && !stop) {
+          ++r.follow_moving_steps;
+          const Eigen::Vector3d hand = (*nearest_truth)[o.follow->joint].position;
+          Eigen::Vector3d towards = o.world_from_base.translation() - hand;
+          towards.y() = 0;
+          if (towards.norm() < 1e-6) towards = Eigen::Vector3d::UnitZ();
+          const Eigen::Vector3d want = (hand + o.follow->standoff_m * towards.normalized())
+                                           .cwiseMax(o.follow->workspace.min())
+                                           .cwiseMin(o.follow->workspace.max());
+          r.follow_error_m.push_back((arm.tool_world() - want).norm());
+        }
+      }
+    } else {
+      // The arm's own task.
+      if ((arm.tool_world() - o.task[task_next]).norm() < 0.01) {
+        task_next = (task_next + 1) % o.task.size();
+        ++r.task_points_reached;
+      }
+      arm.set_target(o.task[task_next], o.task_speed);
     }
-    arm.set_target(o.task[task_next], o.task_speed);
     arm.step(dt);
   }
   r.seconds = static_cast<double>(r.steps) * dt;

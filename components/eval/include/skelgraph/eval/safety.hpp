@@ -21,6 +21,7 @@
 //    speed, plus 0.3 m).
 
 #include <array>
+#include <optional>
 #include <cstdint>
 #include <map>
 #include <string>
@@ -29,6 +30,7 @@
 #include <Eigen/Geometry>
 
 #include "skelgraph/fusion/fuser.hpp"
+#include "skelgraph/robot/follow.hpp"
 #include "skelgraph/robot/separation.hpp"
 #include "skelgraph/sim/simulation.hpp"
 
@@ -50,6 +52,8 @@ struct SafetyRunOptions {
   double decision_rate_hz = 100.0;  // decisions and arm steps per second
   double command_latency_s = 0.01;  // from a decision to the arm acting on it (and in the reaction time)
   double unnecessary_margin_m = 0.3;
+  // Instead of its task, the arm follows a worker's hand (robot/follow.hpp).
+  std::optional<robot::FollowParams> follow;
 };
 
 struct SafetyRunResult {
@@ -65,6 +69,11 @@ struct SafetyRunResult {
   double min_true_separation_m = 0;     // over the run (+inf: nobody)
   std::uint64_t task_points_reached = 0;
   std::uint64_t stops = 0;              // protective stops commanded
+  // follow: steps with a hand to follow, and of those the ones the arm was
+  // allowed to move; the tool's distance then from where the true hand
+  // would put it (the same standoff and workspace), m.
+  std::uint64_t follow_steps = 0, follow_moving_steps = 0;
+  std::vector<double> follow_error_m;
 };
 
 // One run of the scenario (sim.scenario, its repeats) from start to end.
