@@ -35,6 +35,21 @@ assert all(x["body_part"] and x["robot_part"] for x in near), near[:3]
 print("ok: robot cell: %s; reaction p50 %.0f ms; %d protective stops" % (by, r["p50"], robot["protective_stops"]))
 PY
 
+# Following a hand (bringup/robot_follow.yaml): targets are sent and obeyed, holds when there is no hand.
+"$SKELGRAPH" launch bringup/robot_follow.yaml --duration 8 --json >"$WORK/follow.json" 2>"$WORK/follow.err" ||
+  fail "robot_follow: $(tail -5 "$WORK/follow.err")"
+python3 - "$WORK/follow.json" <<'PY' || fail "robot follow: $(head -c 3000 "$WORK/follow.json")"
+import json, sys
+d = {c["name"]: c for c in json.load(open(sys.argv[1]))["components"]}
+f, robot, sep = d["follow"]["details"], d["robot"]["details"], d["separation"]["details"]
+assert d["follow"]["state"] == "OK" and f["failed_writes"] == 0, d["follow"]
+# The worker's hand is tracked most of the time: targets go out and the robot takes them (with the monitor's commands).
+assert f["following_steps"] > f["steps"] // 2 and f["moves"] >= 2, f
+assert robot["commands"] >= f["moves"] + f["holds"] - 2 and robot["ignored"] == 0, (f, robot)
+assert sep["steps_by_state"].get("PROTECTIVE_STOP", 0) > 0, sep
+print("ok: follow: %d of %d steps following, %d targets, %d holds; monitor %s" % (f["following_steps"], f["steps"], f["moves"], f["holds"], sep["steps_by_state"]))
+PY
+
 # Fail-safe: a robot and its monitor with no sensors at all.
 cat >"$WORK/no_people.yaml" <<'YAML'
 components:
