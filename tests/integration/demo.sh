@@ -7,7 +7,7 @@ source "$(dirname "$0")/lib.sh"
 
 "$SKELGRAPH" demo --duration 6 --json --report "$WORK/report" >"$WORK/demo.json" 2>"$WORK/demo.err" ||
   fail "demo: $(tail -5 "$WORK/demo.err")"
-grep -q "\[demo 4/4\]" "$WORK/demo.err" || fail "demo shows no progress: $(head -c 2000 "$WORK/demo.err")"
+grep -q "\[demo 5/5\]" "$WORK/demo.err" || fail "demo shows no progress: $(head -c 2000 "$WORK/demo.err")"
 python3 - "$WORK/demo.json" <<'PY' || fail "demo report: $(head -c 3000 "$WORK/demo.json")"
 import json, os, sys
 d = json.load(open(sys.argv[1]))
@@ -19,6 +19,11 @@ for s in ("walk", "360", "hide", "box", "occ", "sit", "arms"):
 assert "<h1>Layout quarters:2</h1>" in html and "<h1>Layout ring:4</h1>" in html
 assert "<h2>live graph" in html
 assert "<h2>Pointing" in html
+# The robot cell, judged against the truth: the arm never moved too close, it was stopped for the workers, and the timeline is drawn.
+assert "<h2>Robot cell" in html and "The monitor's state" in html, "robot section"
+r = d["robot"]
+assert r["missed_steps"] == 0 and r["stops"] >= 1 and 0 < r["stop_pct"] < 100 and r["seconds"] > 20 and r["task_points_reached"] >= 1, r
+assert os.path.exists(os.path.join(os.path.dirname(d["report"]), "robot_state.svg"))
 p = d["pointing"]
 assert p["truth"] == 24 and p["recall"] >= 0.8 and p["precision"] >= 0.8 and p["median_target_error_m"] < 0.4, p
 c = {x["name"]: x for x in d["components"]}

@@ -245,12 +245,8 @@ TEST(Separation, AStopIsReleasedOnlyAfterTheWayHasBeenClearForAWhile) {
 // close for its speed.
 namespace {
 skelgraph::eval::SafetyRunOptions robot_cell(int repeats) {
-  skelgraph::eval::SafetyRunOptions o;
-  o.sim.scenario.name = "robot";
+  auto o = skelgraph::eval::robot_cell_options();
   o.sim.scenario.repeats = repeats;
-  o.sim.sensors = skelgraph::sim::layout_sensors("ring", 4);
-  o.world_from_base = base_pose(0.0, 0.0, 1.9, 180.0);
-  o.task = {{0.45, 0.6, 1.5}, {-0.45, 0.6, 1.5}, {-0.3, 0.3, 1.35}, {0.3, 0.3, 1.35}};
   return o;
 }
 }  // namespace

@@ -67,7 +67,7 @@ int eval_safety(const SafetyOptions& o) {
                            "to stop p99", "reaction p99", "stop %", "unnec %", "stops");
   for (const int people : o.people) {
     for (const int seed : o.seeds) {
-      eval::SafetyRunOptions so;
+      auto so = eval::robot_cell_options();
       // Four sensors round the cell unless -p says otherwise: with two (the robot by sensor 1) a worker
       // walking round the arm goes unseen (measured: 160 steps in 37 minutes where the arm moved too close).
       std::vector<std::string> params = o.params;
@@ -89,10 +89,6 @@ int eval_safety(const SafetyOptions& o) {
         so.follow.emplace();
         so.follow->standoff_m = o.standoff_m;
       }
-      // bringup/robot_cell.yaml's arm and task.
-      so.world_from_base = robot::base_pose(0.0, 0.0, 1.9, 180.0);
-      so.task = {{0.45, 0.6, 1.5}, {-0.45, 0.6, 1.5}, {-0.3, 0.3, 1.35}, {0.3, 0.3, 1.35}};
-      so.task_speed = 0.5;
       std::fprintf(stderr, "[eval safety] people %d, seed %d ...\n", people, seed);
       const auto r = eval::run_safety(so);
       auto j = run_json(r);

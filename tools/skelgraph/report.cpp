@@ -124,7 +124,7 @@ std::string line_plot(const std::string& title, const std::string& x_label, cons
   return o.str();
 }
 
-std::string timeline(const std::string& title, const std::vector<Strip>& strips, int width) {
+std::string timeline(const std::string& title, const std::vector<Strip>& strips, int width, const std::string& legend) {
   const int left = 90, right = 20, top = 28, row = 16;
   const int pw = width - left - right, height = top + row * static_cast<int>(strips.size()) + 30;
   double x0 = std::numeric_limits<double>::infinity(), x1 = -x0;
@@ -159,7 +159,7 @@ std::string timeline(const std::string& title, const std::vector<Strip>& strips,
   }
   const double ty = top + row * static_cast<double>(strips.size()) + 14;
   o << "<text x=\"" << left << "\" y=\"" << ty << "\">" << fmt(x0) << " s</text><text x=\"" << left + pw << "\" y=\"" << ty
-    << "\" text-anchor=\"end\">" << fmt(x1) << " s (green: reported at confidence 1; red: not)</text>\n</svg>\n";
+    << "\" text-anchor=\"end\">" << fmt(x1) << " s (" << html_escape(legend) << ")</text>\n</svg>\n";
   return o.str();
 }
 

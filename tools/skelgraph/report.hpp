@@ -22,7 +22,8 @@ struct Strip {
   std::vector<double> x;
   std::vector<bool> on;
 };
-std::string timeline(const std::string& title, const std::vector<Strip>& strips, int width = 760);
+std::string timeline(const std::string& title, const std::vector<Strip>& strips, int width = 760,
+                     const std::string& legend = "green: reported at confidence 1; red: not");
 
 std::string html_escape(const std::string& s);
 

@@ -40,6 +40,16 @@ Nearest nearest(const std::vector<skeleton::Skeleton>& people, const std::vector
 }
 }  // namespace
 
+SafetyRunOptions robot_cell_options() {
+  SafetyRunOptions o;
+  o.sim.scenario.name = "robot";
+  o.sim.sensors = sim::layout_sensors("ring", 4);
+  o.world_from_base = robot::base_pose(0.0, 0.0, 1.9, 180.0);
+  o.task = {{0.45, 0.6, 1.5}, {-0.45, 0.6, 1.5}, {-0.3, 0.3, 1.35}, {0.3, 0.3, 1.35}};
+  o.task_speed = 0.5;
+  return o;
+}
+
 SafetyRunResult run_safety(const SafetyRunOptions& o) {
   if (o.task.empty() && !o.follow) throw std::invalid_argument("safety run: the arm needs a task (points for its tool) or a hand to follow");
   if (!(o.decision_rate_hz > 0) || !(o.fuse_period_s > 0))
@@ -65,7 +75,7 @@ SafetyRunResult run_safety(const SafetyRunOptions& o) {
   const auto steps = static_cast<std::uint64_t>(std::floor(sim.duration() / dt));
   std::vector<skeleton::Skeleton> people;  // the latest fused output
   std::int64_t last_frame_ns = std::numeric_limits<std::int64_t>::min();
-  double next_fuse = 0.0;
+  double next_fuse = 0.0, next_trace = 0.0;
   struct Command {
     double at;
     robot::SafetyState state;
@@ -130,6 +140,11 @@ SafetyRunResult run_safety(const SafetyRunOptions& o) {
 
     // Judged against the truth: where the people really are, how fast the arm really moves.
     const auto truth = nearest(sim.truth_at(now), arm_caps);
+    if (o.trace_period_s > 0 && now + 1e-9 >= next_trace) {
+      const auto finite_or_nan = [](double v) { return std::isfinite(v) ? v : std::nan(""); };
+      r.trace.push_back({now, finite_or_nan(truth.distance), finite_or_nan(seen.distance), finite_or_nan(d.protective_m), d.state});
+      next_trace += o.trace_period_s;
+    }
     r.min_true_separation_m = std::min(r.min_true_separation_m, truth.distance);
     if (std::isfinite(truth.distance) && std::isfinite(in.reaction_s)) {
       const double sp = robot::protective_distance(o.params, stopping, truth.distance, arm.tool_speed(), in.reaction_s, 0.0);

@@ -54,6 +54,15 @@ struct SafetyRunOptions {
   double unnecessary_margin_m = 0.3;
   // Instead of its task, the arm follows a worker's hand (robot/follow.hpp).
   std::optional<robot::FollowParams> follow;
+  double trace_period_s = 0;        // > 0: a TracePoint this often (for plots)
+};
+
+// The run over time, for plots: separations (m; NaN: nobody) and the state.
+struct SafetyTracePoint {
+  double t = 0;
+  double true_m = 0, seen_m = 0;  // the truth's and the fused people's separation from the arm
+  double protective_m = 0;        // S_p the monitor used (its speed, reaction time, Z_d)
+  robot::SafetyState state = robot::SafetyState::ProtectiveStop;
 };
 
 struct SafetyRunResult {
@@ -74,7 +83,13 @@ struct SafetyRunResult {
   // would put it (the same standoff and workspace), m.
   std::uint64_t follow_steps = 0, follow_moving_steps = 0;
   std::vector<double> follow_error_m;
+  std::vector<SafetyTracePoint> trace;  // with trace_period_s
 };
+
+// bringup/robot_cell.yaml's cell: the `robot` scenario watched by four
+// sensors in a ring, the arm's base 1.9 m ahead of the worker, its tool round
+// four points beside the walkway at 0.5 m/s.
+SafetyRunOptions robot_cell_options();
 
 // One run of the scenario (sim.scenario, its repeats) from start to end.
 // Throws std::invalid_argument for a bad configuration (an empty task).
