@@ -279,6 +279,25 @@ TEST(SafetyRun, TheJudgeCatchesASlowMonitor) {
   EXPECT_GT(skelgraph::eval::quantile(r.time_to_stop_ms, 1.0), 100.0);
 }
 
+// Every sensor falls silent from 8 s on: the monitor stops the arm (the
+// people data grows old, the sensors are lost) and keeps it stopped.
+TEST(SafetyRun, EverySensorSilentStopsTheArm) {
+  auto o = robot_cell(2);
+  o.trace_period_s = 0.1;
+  for (const auto& s : o.sim.sensors) o.dropouts.push_back({s.id, 8.0, 0.0, 1000.0});
+  const auto r = skelgraph::eval::run_safety(o);
+  // Too close only while the last data grew old (max_people_age_s, 25 steps), if at all.
+  EXPECT_LE(r.missed_steps, 25u);
+  std::size_t after = 0, stopped = 0;
+  for (const auto& p : r.trace) {
+    if (p.t < 8.6) continue;  // 0.25 s for the data to grow old, the command latency, a tick
+    ++after;
+    stopped += p.state == SafetyState::ProtectiveStop;
+  }
+  EXPECT_GT(after, 100u);
+  EXPECT_EQ(stopped, after);
+}
+
 TEST(SafetyRun, QuantilesAndBadConfigurations) {
   EXPECT_EQ(skelgraph::eval::quantile({}, 0.5), 0.0);
   EXPECT_EQ(skelgraph::eval::quantile({3, 1, 2, 4}, 0.5), 2.0);

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -27,9 +28,34 @@ struct SafetyOptions {
   double release_ms = 500.0;
   double uncertainty_scale = 1.0;
   bool follow = false;
+  std::vector<std::string> dropouts;  // SENSOR,EVERY_S,FOR_S
+  int min_sensors = 2;  // robot_cell.yaml's: with three of four sensors silent at once, 1 let the arm move too close
   double standoff_m = 0.8;
   bool json = false;
 };
+
+// "SENSOR,EVERY_S,FOR_S": the sensor silent FOR_S seconds in every EVERY_S (from EVERY_S - FOR_S on).
+eval::SafetyRunOptions::Dropout parse_dropout(const std::string& spec, const sim::SimConfig& cfg) {
+  eval::SafetyRunOptions::Dropout d;
+  std::stringstream ss(spec);
+  std::string sensor, every, length, extra;
+  if (!std::getline(ss, sensor, ',') || !std::getline(ss, every, ',') || !std::getline(ss, length, ',') ||
+      std::getline(ss, extra, ','))
+    throw UsageError("--dropout '" + spec + "': expected SENSOR,EVERY_S,FOR_S (e.g. sensor1,20,5)");
+  if (std::none_of(cfg.sensors.begin(), cfg.sensors.end(), [&](const sim::SensorConfig& s) { return s.id == sensor; }))
+    throw UsageError("--dropout '" + spec + "': no sensor '" + sensor + "' in this cell");
+  try {
+    d.every_s = std::stod(every);
+    d.for_s = std::stod(length);
+  } catch (const std::exception&) {
+    throw UsageError("--dropout '" + spec + "': EVERY_S and FOR_S must be numbers");
+  }
+  if (!(d.every_s > 0 && d.for_s > 0 && d.for_s < d.every_s))
+    throw UsageError("--dropout '" + spec + "': need 0 < FOR_S < EVERY_S");
+  d.sensor = sensor;
+  d.from_s = d.every_s - d.for_s;
+  return d;
+}
 
 nlohmann::json run_json(const eval::SafetyRunResult& r) {
   const auto share = [&](std::uint64_t n) { return r.steps > 0 ? 100.0 * static_cast<double>(n) / static_cast<double>(r.steps) : 0.0; };
@@ -85,6 +111,8 @@ int eval_safety(const SafetyOptions& o) {
       so.command_latency_s = o.command_latency_ms * 1e-3;
       so.release_s = o.release_ms * 1e-3;
       so.uncertainty_scale = o.uncertainty_scale;
+      so.min_sensors = o.min_sensors;
+      for (const auto& spec : o.dropouts) so.dropouts.push_back(parse_dropout(spec, so.sim));
       if (o.follow) {
         so.follow.emplace();
         so.follow->standoff_m = o.standoff_m;
@@ -169,6 +197,10 @@ void add_eval_safety_command(CLI::App& eval, Action& run) {
   c->add_option("--uncertainty-scale", o->uncertainty_scale,
                 "Z_d is the fused joints' 95 % radius times this (1, as the separation component; 0 leaves it out, to see what it costs)")
       ->check(CLI::Range(0.0, 10.0));
+  c->add_option("--dropout", o->dropouts,
+                "a sensor falling silent: SENSOR,EVERY_S,FOR_S (e.g. sensor1,20,5: 5 s in every 20 s); repeatable");
+  c->add_option("--min-sensors", o->min_sensors, "fewer live sensors than this: protective stop (the separation component's min_sensors; default 2, as robot_cell.yaml)")
+      ->check(CLI::Range(0, 64));
   c->add_flag("--follow", o->follow, "the arm follows the worker's right hand instead of its task (robot/follow.hpp)");
   c->add_option("--standoff-m", o->standoff_m, "follow: the tool keeps this far from the hand, on the robot's side")
       ->check(CLI::Range(0.0, 3.0));

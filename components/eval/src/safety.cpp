@@ -76,6 +76,7 @@ SafetyRunResult run_safety(const SafetyRunOptions& o) {
   std::vector<skeleton::Skeleton> people;  // the latest fused output
   std::int64_t last_frame_ns = std::numeric_limits<std::int64_t>::min();
   double next_fuse = 0.0, next_trace = 0.0;
+  std::map<std::string, std::int64_t> sensor_seen_ns;  // last frame per sensor
   struct Command {
     double at;
     robot::SafetyState state;
@@ -96,11 +97,15 @@ SafetyRunResult run_safety(const SafetyRunOptions& o) {
     // What reached fusion by now (a hop after the sensor delivered it).
     for (auto& e : sim.advance(now - o.hop_s)) {
       const std::int64_t arrival = std::llround((e.t + o.hop_s) * 1e9);
+      const auto& id = e.skeleton.sensor_id;
+      if (std::any_of(o.dropouts.begin(), o.dropouts.end(), [&](const auto& d) { return d.sensor == id && d.silent(e.t); }))
+        continue;  // a silent sensor delivers nothing
       switch (e.kind) {
         case sim::SimEvent::Kind::Raw: fuser.add(e.skeleton, arrival); break;
         case sim::SimEvent::Kind::Frame:
           fuser.heartbeat(e.skeleton.sensor_id, arrival);
           last_frame_ns = std::max(last_frame_ns, arrival);
+          sensor_seen_ns[e.skeleton.sensor_id] = arrival;
           break;
         case sim::SimEvent::Kind::Lost: fuser.remove(e.skeleton.sensor_id, e.skeleton.person_id); break;
         default: break;
@@ -115,6 +120,9 @@ SafetyRunResult run_safety(const SafetyRunOptions& o) {
     const auto arm_caps = arm.capsules();
     robot::SeparationInput in;
     in.robot_age_s = 0.0;
+    int live = 0;
+    for (const auto& [sensor, seen_ns] : sensor_seen_ns) live += static_cast<double>(now_ns - seen_ns) * 1e-9 <= o.sensor_timeout_s;
+    in.coverage_lost = live < o.min_sensors;
     in.robot_speed = arm.tool_speed();
     in.robot_max_speed = o.task_speed;
     double age = last_frame_ns == std::numeric_limits<std::int64_t>::min() ? kInf
@@ -152,12 +160,12 @@ SafetyRunResult run_safety(const SafetyRunOptions& o) {
       if (danger && !stop) ++r.missed_steps;
       if (danger && !danger_before) {
         ++r.intrusions;
-        if (stop) {
-          r.time_to_stop_ms.push_back(0.0);
-        } else {
-          waiting_for_stop = true;
-          danger_since = now;
-        }
+        if (stop) r.time_to_stop_ms.push_back(0.0);  // already stopped
+      }
+      if (danger && !stop && !waiting_for_stop) {
+        // Too close and allowed to move (from the intrusion's start, or from a release within it).
+        waiting_for_stop = true;
+        danger_since = now;
       }
       if (waiting_for_stop && (stop || !danger)) {
         r.time_to_stop_ms.push_back((now - danger_since) * 1e3);  // (danger over without a stop: as long as it lasted)

@@ -12,15 +12,16 @@
 // then, no position uncertainty):
 //  - missed: the true separation is below the true S_p while the state is
 //    RUN or REDUCED (the robot was allowed to move, too fast for the truth);
-//  - an intrusion starts where a missed step follows one that was not, or
-//    where the true separation drops below the true S_p while the robot is
-//    allowed to move; its time to stop runs from the intrusion's start to the
-//    first PROTECTIVE_STOP decision (0 if it never let the robot move);
+//  - an intrusion starts where the true separation drops below the true S_p;
+//    a time to stop is counted from there (or from a release while still too
+//    close) to the next PROTECTIVE_STOP decision, or to the intrusion's end
+//    if none came; 0 when the robot was stopped already;
 //  - unnecessary: PROTECTIVE_STOP while the truth leaves room for a useful
 //    speed (the true separation at least S_p at min_scale times the asked
 //    speed, plus 0.3 m).
 
 #include <array>
+#include <cmath>
 #include <optional>
 #include <cstdint>
 #include <map>
@@ -55,6 +56,20 @@ struct SafetyRunOptions {
   // Instead of its task, the arm follows a worker's hand (robot/follow.hpp).
   std::optional<robot::FollowParams> follow;
   double trace_period_s = 0;        // > 0: a TracePoint this often (for plots)
+  // A sensor falling silent (no frames, no skeletons) for `for_s` every
+  // `every_s` seconds, from `from_s` on: the monitor sees it as lost after
+  // sensor_timeout_s; fewer live sensors than min_sensors is a stop.
+  struct Dropout {
+    std::string sensor;
+    double from_s = 0, every_s = 0, for_s = 0;
+    bool silent(double t) const {
+      if (t < from_s) return false;
+      return every_s > 0 ? std::fmod(t - from_s, every_s) < for_s : t - from_s < for_s;
+    }
+  };
+  std::vector<Dropout> dropouts;
+  double sensor_timeout_s = 0.5;
+  int min_sensors = 2;
 };
 
 // The run over time, for plots: separations (m; NaN: nobody) and the state.
