@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <limits>
 #include <map>
+#include <memory>
 #include <random>
 #include <stdexcept>
 #include <set>
@@ -861,13 +862,22 @@ TEST(Evaluation, EventsOutOfOrderAndLateSensorsAreHandled) {
   EXPECT_EQ(r.streams[1].ticks, r.ticks);
 }
 
-// Identity: a recorded fused stream that gives the one true person id 5,
-// then 6, then 6 again, then 5 has switched twice in its 3 s.
-TEST(Evaluation, IdSwitchesAreCountedAgainstTheTruePerson) {
+namespace {
+// An evaluation of one recorded fused stream ("fused") alone: no methods re-run, no single sensors.
+std::unique_ptr<eval::Evaluator> recorded_fused_only() {
   eval::OfflineOptions o;
   o.methods = {};
   o.singles = false;
-  eval::Evaluator ev({{"s1", Eigen::Isometry3d::Identity()}}, {"s1"}, {"fused"}, o);
+  return std::make_unique<eval::Evaluator>(std::map<std::string, Eigen::Isometry3d>{{"s1", Eigen::Isometry3d::Identity()}},
+                                           std::vector<std::string>{"s1"}, std::vector<std::string>{"fused"}, o);
+}
+}  // namespace
+
+// Identity: a recorded fused stream that gives the one true person id 5,
+// then 6, then 6 again, then 5 has switched twice in its 3 s.
+TEST(Evaluation, IdSwitchesAreCountedAgainstTheTruePerson) {
+  auto evp = recorded_fused_only();
+  auto& ev = *evp;
   for (std::int64_t k = 0; k <= 90; ++k) {
     const std::int64_t t = 1'000'000'000 + k * 33'333'333;
     auto truth = person("truth", 1, {0, 1, 0});
@@ -888,10 +898,8 @@ TEST(Evaluation, IdSwitchesAreCountedAgainstTheTruePerson) {
 // A person nobody reports for 1.5 s who comes back under a new id: a switch
 // after a gap (nobody can tell them from someone new without appearance).
 TEST(Evaluation, ASwitchAfterAGapIsCountedApart) {
-  eval::OfflineOptions o;
-  o.methods = {};
-  o.singles = false;
-  eval::Evaluator ev({{"s1", Eigen::Isometry3d::Identity()}}, {"s1"}, {"fused"}, o);
+  auto evp = recorded_fused_only();
+  auto& ev = *evp;
   for (std::int64_t k = 0; k <= 150; ++k) {
     const std::int64_t t = 1'000'000'000 + k * 33'333'333;
     ev.add({eval::TimedSkeleton::Kind::Truth, t, person("truth", 1, {0, 1, 0})});
@@ -911,10 +919,8 @@ TEST(Evaluation, ASwitchAfterAGapIsCountedApart) {
 // (each nearer the other person) keep their ids; a third person nobody
 // reports is missed on every tick.
 TEST(Evaluation, EveryTruePersonIsScoredAndKeepsItsOutput) {
-  eval::OfflineOptions o;
-  o.methods = {};
-  o.singles = false;
-  eval::Evaluator ev({{"s1", Eigen::Isometry3d::Identity()}}, {"s1"}, {"fused"}, o);
+  auto evp = recorded_fused_only();
+  auto& ev = *evp;
   for (std::int64_t k = 0; k <= 90; ++k) {
     const std::int64_t t = 1'000'000'000 + k * 33'333'333;
     ev.add({eval::TimedSkeleton::Kind::Truth, t, person("truth", 1, {0, 1, 0})});
