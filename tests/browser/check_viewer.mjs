@@ -51,6 +51,7 @@ try {
   out.gestures = { events: b.gestures.length, drawn: b.drawnGestures,
                    text: await page.locator('#gestures').innerText() };
   out.software_gl = b.software;
+  out.robots = { drawn: b.drawnRobots, text: await page.locator('#robots').innerText() };
   out.snapshots = snapshots;
 
   // Layer toggle: hide the first sensor's skeleton.

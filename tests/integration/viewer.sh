@@ -100,6 +100,12 @@ check(p["drawn_while_paused"] == 0 and p["received_while_paused"] >= 20 and p["d
 g = page["gestures"]
 check(g["events"] >= 1 and g["drawn"]["rays"] >= 1 and g["drawn"]["targets"] >= 1
       and "pointing by person 7 (right arm) at floor" in g["text"], f"gestures: {g}")
+if sensors == 4:  # bringup/sim_quad_viewer.yaml has a robot and its monitor
+    r = page["robots"]
+    colours = {"RUN": 0x3fbf5f, "REDUCED": 0xffb020, "PROTECTIVE_STOP": 0xff3030}
+    check(len(r["drawn"]) == 1 and r["drawn"][0]["id"] == "robot1" and r["drawn"][0]["capsules"] == 7
+          and r["drawn"][0]["state"] in colours and r["drawn"][0]["colour"] == colours[r["drawn"][0]["state"]]
+          and "robot1: " in r["text"], f"robots: {r}")
 m = page["malformed"]
 check(any("unknown cmd 'rewind'" in e for e in m["errors"]) and m["still_receiving"] and m["connected"], f"malformed request: {m}")
 for p_ in problems: print("  " + p_)

@@ -234,3 +234,40 @@ TEST(ViewerClientCommand, RefusesMalformedRequestsSayingWhy) {
     EXPECT_NE(p.error.find(why), std::string::npos) << text << " -> " << p.error;
   }
 }
+
+// The robot and its monitor's verdict in the frame: capsules (m, to the
+// mm), the tool, the safety state; gone when not heard of for a while.
+TEST(ViewerScene, RobotsAreDrawnWithTheirCapsulesAndSafetyState) {
+  Scene scene;
+  const nlohmann::json cap = {{"a", {{"x", 0.0}, {"y", 0.1}, {"z", 1.9}}},
+                              {"b", {{"x", 0.0}, {"y", 0.6}, {"z", 1.9}}},
+                              {"radius", 0.08},
+                              {"name", "base"}};
+  scene.on_robot({{"robot_id", "robot1"},
+                  {"capsules", {cap}},
+                  {"tool_position", {{"x", 0.3}, {"y", 0.6}, {"z", 1.35}}},
+                  {"speed_scale", 0.5},
+                  {"protective_stop", false}},
+                 0);
+  auto f = scene.frame(1'000'000);
+  ASSERT_EQ(f["robots"].size(), 1u);
+  const auto& r = f["robots"][0];
+  EXPECT_EQ(r["id"], "robot1");
+  EXPECT_EQ(r["capsules"][0], (nlohmann::json{0.0, 0.1, 1.9, 0.0, 0.6, 1.9, 0.08}));
+  EXPECT_EQ(r["tool"], (nlohmann::json{0.3, 0.6, 1.35}));
+  EXPECT_TRUE(r["safety"].is_null());  // no verdict yet
+  scene.on_safety({{"robot_id", "robot1"},
+                   {"state", "PROTECTIVE_STOP"},
+                   {"separation_m", 0.42},
+                   {"protective_m", 0.61},
+                   {"person_id", 3},
+                   {"body_part", "right_hand"},
+                   {"robot_part", "tool"},
+                   {"reason", "person 3 right_hand / tool: 0.42 m, S_p 0.61 m"}},
+                  2'000'000);
+  f = scene.frame(3'000'000);
+  EXPECT_EQ(f["robots"][0]["safety"]["state"], "PROTECTIVE_STOP");
+  EXPECT_EQ(f["robots"][0]["safety"]["body_part"], "right_hand");
+  // Not heard of for longer than status_max_age_ns: not drawn.
+  EXPECT_TRUE(scene.frame(6'000'000'000).at("robots").empty());
+}

@@ -73,6 +73,16 @@ void Scene::on_status(const std::string& component, nlohmann::json status, std::
 
 void Scene::on_player(const std::string& player, nlohmann::json state) { players_[player] = std::move(state); }
 
+void Scene::on_robot(nlohmann::json state, std::int64_t now_ns) {
+  const auto id = state.value("robot_id", std::string());
+  robots_[id] = {now_ns, std::move(state)};
+}
+
+void Scene::on_safety(nlohmann::json status, std::int64_t now_ns) {
+  const auto id = status.value("robot_id", std::string());
+  safety_[id] = {now_ns, std::move(status)};
+}
+
 nlohmann::json Scene::frame(std::int64_t now_ns) {
   nlohmann::json skeletons = nlohmann::json::array();
   for (auto it = skeletons_.begin(); it != skeletons_.end();) {
@@ -133,6 +143,37 @@ nlohmann::json Scene::frame(std::int64_t now_ns) {
   }
   nlohmann::json players = nlohmann::json::array();
   for (const auto& [name, p] : players_) players.push_back(p);
+  nlohmann::json robots = nlohmann::json::array();
+  const auto mm3 = [](const nlohmann::json& v) { return nlohmann::json{mm(v["x"].get<double>()), mm(v["y"].get<double>()), mm(v["z"].get<double>())}; };
+  for (auto it = robots_.begin(); it != robots_.end();) {
+    if (now_ns - it->second.first > o_.status_max_age_ns) {
+      it = robots_.erase(it);
+      continue;
+    }
+    const auto& r = it->second.second;
+    nlohmann::json capsules = nlohmann::json::array();
+    for (const auto& c : r["capsules"]) {
+      auto row = mm3(c["a"]);
+      for (const auto& v : mm3(c["b"])) row.push_back(v);
+      row.push_back(mm(c["radius"].get<double>()));
+      capsules.push_back(std::move(row));
+    }
+    nlohmann::json safety;
+    const auto s = safety_.find(it->first);
+    if (s != safety_.end() && now_ns - s->second.first <= o_.status_max_age_ns) {
+      const auto& v = s->second.second;
+      safety = {{"state", v["state"]},           {"separation_m", v["separation_m"]}, {"protective_m", v["protective_m"]},
+                {"person_id", v["person_id"]},   {"body_part", v["body_part"]},       {"robot_part", v["robot_part"]},
+                {"reason", v["reason"]}};
+    }
+    robots.push_back({{"id", it->first},
+                      {"capsules", std::move(capsules)},
+                      {"tool", mm3(r["tool_position"])},
+                      {"speed_scale", r["speed_scale"]},
+                      {"stopped", r["protective_stop"]},
+                      {"safety", std::move(safety)}});
+    ++it;
+  }
   return {{"type", "frame"},
           {"seq", ++seq_},
           {"skeletons", std::move(skeletons)},
@@ -142,7 +183,8 @@ nlohmann::json Scene::frame(std::int64_t now_ns) {
           {"unplaced", std::move(unplaced)},
           {"gestures", std::move(gestures)},
           {"status", std::move(status)},
-          {"players", std::move(players)}};
+          {"players", std::move(players)},
+          {"robots", std::move(robots)}};
 }
 
 }  // namespace skelgraph::viewer

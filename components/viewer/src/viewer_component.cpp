@@ -68,7 +68,11 @@ ViewerComponent::ViewerComponent(runtime::Context& ctx, const runtime::Params& p
                     scene_.on_status(s.component_name().to_string(), s, now_mono());
                   }),
       play_state_sub_(ctx, runtime::topics::kPlayState,
-                      [this](const msg::PlayState& s, const runtime::SampleMeta&) { scene_.on_player(s.player().to_string(), s); }) {
+                      [this](const msg::PlayState& s, const runtime::SampleMeta&) { scene_.on_player(s.player().to_string(), s); }),
+      robot_sub_(ctx, runtime::topics::kRobotState,
+                 [this](const msg::RobotState& s, const runtime::SampleMeta&) { scene_.on_robot(s, now_mono()); }),
+      safety_sub_(ctx, runtime::topics::kSafety,
+                  [this](const msg::SafetyStatus& s, const runtime::SampleMeta&) { scene_.on_safety(s, now_mono()); }) {
   std::string root = params.get<std::string>("web_root");
   if (root.empty()) root = SKELGRAPH_VIEWER_WEB_DIR;
   Server::Options o;

@@ -13,7 +13,7 @@ const FIXED_COLOURS = { fused: 0xff7f2a, truth: 0x5fdf5f };
 const stats = {
   connected: false, framesReceived: 0, framesDrawn: 0, fps: 0, lastSeq: 0, paused: false,
   drawn: { skeletons: 0, joints: 0, list: [] }, sensors: 0, gestures: [], drawnGestures: { rays: 0, targets: 0 },
-  errors: [], replies: [], players: [],
+  errors: [], replies: [], players: [], drawnRobots: [],
 };
 window.skelgraphViewer = stats;
 
@@ -88,6 +88,7 @@ function layer(name, label, colour) {
 layer('sensors', 'sensors and frustums', 0x9aa5b1);
 layer('gestures', 'gestures', 0xff4040);
 layer('uncertainty', 'uncertainty (95 % spheres)', 0xc0c0c0);
+layer('robots', 'robots (safety state)', 0x9aa5b1);
 
 // --- skeletons ------------------------------------------------------------
 const skeletons = new Map();  // "stream/person" -> drawn objects
@@ -226,6 +227,64 @@ function drawGestures(all) {
   }));
 }
 
+// --- robots: capsules coloured by the monitor's verdict -------------------------
+const SAFETY_COLOURS = { RUN: 0x3fbf5f, REDUCED: 0xffb020, PROTECTIVE_STOP: 0xff3030 };
+const robotGroup = new THREE.Group();
+scene.add(robotGroup);
+const robotMaterials = new Map();
+function robotMaterial(state) {
+  const key = state || 'none';
+  if (!robotMaterials.has(key)) {
+    robotMaterials.set(key, new THREE.MeshLambertMaterial({ color: SAFETY_COLOURS[state] ?? 0x9aa5b1, transparent: true, opacity: 0.8 }));
+  }
+  return robotMaterials.get(key);
+}
+const capsuleBody = new THREE.CylinderGeometry(1, 1, 1, 16, 1, true);
+const capsuleEnd = new THREE.SphereGeometry(1, 16, 12);
+const up = new THREE.Vector3(0, 1, 0);
+function drawRobots(robots) {
+  robotGroup.clear();
+  robotGroup.visible = layers.get('robots').visible;
+  const drawn = [];
+  for (const r of robots) {
+    const state = r.safety ? r.safety.state : null;
+    const material = robotMaterial(state);
+    let capsules = 0;
+    for (const c of r.capsules) {
+      const a = new THREE.Vector3(c[0], c[1], c[2]), b = new THREE.Vector3(c[3], c[4], c[5]), radius = c[6];
+      const axis = new THREE.Vector3().subVectors(b, a);
+      const length = axis.length();
+      if (length > 1e-6) {
+        const body = new THREE.Mesh(capsuleBody, material);
+        body.scale.set(radius, length, radius);
+        body.position.copy(a).addScaledVector(axis, 0.5);
+        body.quaternion.setFromUnitVectors(up, axis.normalize());
+        robotGroup.add(body);
+      }
+      for (const p of [a, b]) {
+        const end = new THREE.Mesh(capsuleEnd, material);
+        end.scale.setScalar(radius);
+        end.position.copy(p);
+        robotGroup.add(end);
+      }
+      ++capsules;
+    }
+    drawn.push({ id: r.id, capsules, state, colour: material.color.getHex() });
+  }
+  stats.drawnRobots = robotGroup.visible ? drawn : [];
+  const el = document.getElementById('robots');
+  if (robots.length === 0) { el.textContent = 'none'; return; }
+  el.replaceChildren(...robots.map((r) => {
+    const div = document.createElement('div');
+    const s = r.safety;
+    let t = `${r.id}: ${s ? s.state : 'no verdict yet'}, speed ${Math.round(100 * r.speed_scale)} %`;
+    if (s && s.separation_m >= 0) t += `; person ${s.person_id} ${s.body_part} ${s.separation_m.toFixed(2)} m (S_p ${s.protective_m.toFixed(2)} m)`;
+    div.textContent = t;
+    if (s) div.title = s.reason;
+    return div;
+  }));
+}
+
 // --- panel: status, players -------------------------------------------------
 function drawStatus(list) {
   const el = document.getElementById('status');
@@ -308,6 +367,7 @@ function apply(frame) {
   stats.gestures = frame.gestures;
   stats.players = frame.players;
   drawGestures(frame.gestures);
+  drawRobots(frame.robots || []);
   drawStatus(frame.status);
   drawPlayers(frame.players);
   stats.lastSeq = frame.seq;

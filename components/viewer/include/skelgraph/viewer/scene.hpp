@@ -52,10 +52,18 @@ class Scene {
   void on_gesture(nlohmann::json event, std::int64_t now_ns);
   void on_status(const std::string& component, nlohmann::json status, std::int64_t now_ns);
   void on_player(const std::string& player, nlohmann::json state);
+  // A robot's state and its monitor's verdict (the adapter converts
+  // RobotState and SafetyStatus; keyed by robot_id). A robot not heard of
+  // for status_max_age_ns is no longer drawn.
+  void on_robot(nlohmann::json state, std::int64_t now_ns);
+  void on_safety(nlohmann::json status, std::int64_t now_ns);
 
   // The frame message: {"type":"frame", "seq", "skeletons": [...], "sensors": [...],
   // (each skeleton's joints [x, y, z, state, radius_95], m; state 0: not drawn)
-  // "streams": {...}, "gestures": [...], "status": [...], "players": [...], "unplaced": [...]}.
+  // "streams": {...}, "gestures": [...], "status": [...], "players": [...], "unplaced": [...],
+  // "robots": [{"id", "capsules": [[ax, ay, az, bx, by, bz, radius], ...], "tool": [x, y, z] (m, to the mm),
+  //   "speed_scale", "stopped", "safety": the verdict (state, separation_m, protective_m, person_id,
+  //   body_part, robot_part, reason) or null}]}.
   // Drops what has aged out as of now_ns.
   nlohmann::json frame(std::int64_t now_ns);
 
@@ -78,6 +86,7 @@ class Scene {
   std::map<std::string, Stream> streams_;
   std::map<std::string, skeleton::SensorPose> poses_;
   std::vector<std::pair<std::int64_t, nlohmann::json>> gestures_;
+  std::map<std::string, std::pair<std::int64_t, nlohmann::json>> robots_, safety_;  // by robot_id: (received, message)
   std::map<std::string, std::pair<std::int64_t, nlohmann::json>> status_;
   std::map<std::string, nlohmann::json> players_;
 };

@@ -46,6 +46,8 @@ class ViewerComponent final : public runtime::Component {
   runtime::Subscription<msg::GestureEvent> gesture_sub_;
   runtime::Subscription<msg::ComponentStatus> status_sub_;
   runtime::Subscription<msg::PlayState> play_state_sub_;
+  runtime::Subscription<msg::RobotState> robot_sub_;
+  runtime::Subscription<msg::SafetyStatus> safety_sub_;
   runtime::TimerHandle timer_;
 };
 
