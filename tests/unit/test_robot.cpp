@@ -7,9 +7,11 @@
 #include <cmath>
 #include <limits>
 
+#include "skelgraph/eval/fetch.hpp"
 #include "skelgraph/eval/safety.hpp"
 #include "skelgraph/robot/arm.hpp"
 #include "skelgraph/robot/capsule.hpp"
+#include "skelgraph/robot/fetch.hpp"
 #include "skelgraph/robot/follow.hpp"
 #include "skelgraph/robot/separation.hpp"
 
@@ -343,4 +345,31 @@ TEST(Follow, TheToolKeepsItsStandoffFromTheHandAndHoldsWithoutOne) {
   // Person 4 gone: the one with a hand nearest the workspace.
   t = f.step({person(5, Vector3d(0, 1.2, 0.5), now)}, now);
   EXPECT_EQ(t.person, 5u);
+}
+
+// Pointing to fetch: the tool hovers 15 cm above a pointed spot the robot
+// reaches, and goes nowhere for one out of reach or under its own base.
+TEST(Fetch, TheToolHoversAboveAReachableSpotOnly) {
+  const Vector3d base(0, 0, 1.9);
+  const auto t = fetch_target(Vector3d(0.3, 0, 1.4), base);
+  ASSERT_TRUE(t.has_value());
+  EXPECT_TRUE(t->isApprox(Vector3d(0.3, 0.15, 1.4), 1e-12));
+  EXPECT_FALSE(fetch_target(Vector3d(0, 0, 0.5), base).has_value());  // 1.4 m away
+  EXPECT_FALSE(fetch_target(Vector3d(0.1, 0, 1.9), base).has_value());  // the robot's own footprint
+}
+
+// On simulated pointing sessions the chain (spotting, the spotted target,
+// the arm moving to hover) ends most fetches near the true spot; the counts
+// are consistent.
+TEST(Fetch, SpottedPointingSendsTheArmNearTheTrueSpot) {
+  skelgraph::eval::FetchRunOptions o;
+  o.sessions = 4;
+  o.world_from_base = base_pose(0.5, 0.0, 1.2, 180.0);
+  const auto r = skelgraph::eval::run_fetch(o);
+  EXPECT_EQ(r.pointing, 24);  // six in each session
+  EXPECT_GT(r.in_reach, 3);
+  EXPECT_LE(r.spotted, r.in_reach);
+  EXPECT_LE(r.fetched, r.spotted);
+  EXPECT_EQ(static_cast<int>(r.error_m.size()), r.fetched);
+  EXPECT_GT(r.within, r.fetched / 2);
 }

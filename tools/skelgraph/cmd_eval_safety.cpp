@@ -11,8 +11,10 @@
 #include <nlohmann/json.hpp>
 
 #include "cli.hpp"
+#include "skelgraph/eval/fetch.hpp"
 #include "skelgraph/eval/safety.hpp"
 #include "skelgraph/robot/arm.hpp"
+#include "skelgraph/robot/robot_component.hpp"
 
 namespace skelgraph::cli {
 namespace {
@@ -176,9 +178,56 @@ int eval_safety(const SafetyOptions& o) {
   return 0;
 }
 
+struct FetchOptions {
+  int sessions = 24;
+  std::string base = "0,0,1.9,180";  // robot_cell.yaml's
+  bool json = false;
+};
+
+int eval_fetch(const FetchOptions& o) {
+  eval::FetchRunOptions fo;
+  fo.sessions = o.sessions;
+  try {
+    fo.world_from_base = robot::parse_base(o.base);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("--base: ") + e.what());
+  }
+  std::fprintf(stderr, "[eval fetch] training on %d simulated sessions, spotting in %d others ...\n", fo.train_sessions, fo.sessions);
+  const auto r = eval::run_fetch(fo);
+  const double pct = r.in_reach ? 100.0 * r.within / r.in_reach : 0.0;
+  if (o.json) {
+    std::printf("%s\n", nlohmann::json{{"base", o.base},
+                                       {"pointing", r.pointing},
+                                       {"in_reach", r.in_reach},
+                                       {"spotted", r.spotted},
+                                       {"fetched", r.fetched},
+                                       {"within_15cm", r.within},
+                                       {"within_15cm_pct", pct},
+                                       {"error_m", {{"p50", eval::quantile(r.error_m, 0.5)}, {"max", eval::quantile(r.error_m, 1.0)}}}}
+                            .dump(2)
+                            .c_str());
+  } else {
+    std::printf("%d pointing gestures, %d at a spot the robot reaches; %d spotted with a target, %d sent the tool, %d ended "
+                "within 15 cm of the true spot (%.0f %% of those in reach); tool from the true spot: median %.2f m\n",
+                r.pointing, r.in_reach, r.spotted, r.fetched, r.within, pct, eval::quantile(r.error_m, 0.5));
+  }
+  return 0;
+}
+
 }  // namespace
 
 void add_eval_safety_command(CLI::App& eval, Action& run) {
+  auto fo = std::make_shared<FetchOptions>();
+  auto* f = eval.add_subcommand(
+      "fetch",
+      "Pointing to fetch on simulated sessions: a classifier trained on simulated pointing spots it in others; each "
+      "spotted floor target the robot reaches sends the simulated arm's tool to hover above it; how many end within "
+      "15 cm of the true spot");
+  f->add_option("--sessions", fo->sessions, "held-out sessions (default 24, six pointing gestures each)")->check(CLI::Range(1, 100));
+  f->add_option("--base", fo->base, "where the robot stands: x,y,z (m, world; y up),yaw_deg");
+  f->add_flag("--json", fo->json, "machine-readable results");
+  f->callback([fo, &run] { run = [fo] { return eval_fetch(*fo); }; });
+
   auto o = std::make_shared<SafetyOptions>();
   auto* c = eval.add_subcommand(
       "safety",
