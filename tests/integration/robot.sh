@@ -4,7 +4,9 @@
 # the verdicts are published and obeyed (the robot is slowed and stopped, and
 # resumes). Fail-safes: with no people data, and with no robot state, the
 # verdict is a protective stop saying why.
+#   robot.sh SKELGRAPH PUBLISH_GESTURE
 source "$(dirname "$0")/lib.sh"
+PUBLISH_GESTURE=${2:?publish_gesture}
 
 "$SKELGRAPH" topic echo skelgraph/safety --json >"$WORK/safety.jsonl" 2>/dev/null &
 echo_pid=$!
@@ -82,6 +84,32 @@ assert len(state) >= 0.9 * topics["skelgraph/robot/state"] and all(s["robot_id"]
 assert len(safety) >= 0.9 * topics["skelgraph/safety"], (len(safety), topics["skelgraph/safety"])
 print("ok: robot topics recorded (%s) and replayed (%d states, %d safety verdicts)" % (
     {k: v for k, v in topics.items() if "robot" in k or "safety" in k}, len(state), len(safety)))
+PY
+
+# Pointing to fetch: pointing events at (1.4, 0, 0) (publish_gesture), a robot standing 0.7 m from that
+# spot; sensors alive and nobody in the cell (no fusion), so the monitor says RUN: the tool goes to hover above it.
+cat >"$WORK/fetch.yaml" <<'YAML'
+components:
+  - {name: sim, type: sim, params: {scenario: walk, sensor_count: 2, loop: true}}
+  - {name: robot, type: robot, params: {robot_id: robot1, base: "1.4,0,0.7,180"}}
+  - {name: separation, type: separation, params: {robot_id: robot1}}
+  - {name: fetch, type: fetch, params: {robot_id: robot1, base: "1.4,0,0.7,180", label: pointing}}
+YAML
+"$SKELGRAPH" launch "$WORK/fetch.yaml" --duration 9 --json >"$WORK/fetch.json" 2>"$WORK/fetch.err" &
+fetch_launch=$!
+sleep 1
+"$PUBLISH_GESTURE" 6 2>/dev/null
+wait "$fetch_launch" || fail "fetch launch: $(tail -5 "$WORK/fetch.err")"
+python3 - "$WORK/fetch.json" <<'PY' || fail "fetch: $(head -c 3000 "$WORK/fetch.json")"
+import json, math, sys
+d = {c["name"]: c for c in json.load(open(sys.argv[1]))["components"]}
+f, robot = d["fetch"]["details"], d["robot"]["details"]
+assert f["events"] >= 8 and f["sent"] == 1 and f["out_of_reach"] == 0 and f["failed_writes"] == 0, f
+assert f["repeats"] + f["not_run"] + f["sent"] == f["events"], f
+assert math.dist(f["target"], [1.4, 0.15, 0.0]) < 1e-6, f
+# The arm went there.
+assert math.dist(robot["tool"], f["target"]) < 0.03, (robot["tool"], f["target"])
+print("ok: fetch: %d pointing events, the tool sent once to hover above the spot and now %.3f m from it" % (f["events"], math.dist(robot["tool"], f["target"])))
 PY
 
 # Fail-safe: a robot and its monitor with no sensors at all.
