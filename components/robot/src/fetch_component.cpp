@@ -67,16 +67,7 @@ void FetchComponent::on_event(const msg::GestureEvent& e) {
     ++repeats_;
     return;
   } else {
-    msg::RobotCommand c;
-    c.robot_id(robot_id_);
-    c.kind(msg::ROBOT_MOVE_TO);
-    c.value(speed_);
-    c.target().x(target->x());
-    c.target().y(target->y());
-    c.target().z(target->z());
-    c.source(ctx_.name());
-    c.stamp_ns(now);
-    if (command_pub_.publish(c)) {
+    if (command_pub_.publish(command_msg(robot_id_, msg::ROBOT_MOVE_TO, speed_, *target, ctx_.name(), now))) {
       ++sent_count_;
       sent_ = target;
     } else {

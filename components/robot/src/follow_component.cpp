@@ -64,16 +64,8 @@ void FollowComponent::on_start() {
 }
 
 void FollowComponent::command(msg::RobotCommandKind kind, const Eigen::Vector3d& target) {
-  msg::RobotCommand c;
-  c.robot_id(robot_id_);
-  c.kind(kind);
-  c.value(speed_);
-  c.target().x(target.x());
-  c.target().y(target.y());
-  c.target().z(target.z());
-  c.source(ctx_.name());
-  c.stamp_ns(ctx_.clock().now_ns());
-  if (!command_pub_.publish(c)) ++failed_writes_;
+  if (!command_pub_.publish(command_msg(robot_id_, kind, speed_, target, ctx_.name(), ctx_.clock().now_ns())))
+    ++failed_writes_;
 }
 
 void FollowComponent::step() {

@@ -59,6 +59,18 @@ Joints parse_joints_deg(const std::string& text) {
   return q;
 }
 
+msg::RobotCommand command_msg(const std::string& robot_id, msg::RobotCommandKind kind, double value,
+                              const Eigen::Vector3d& target, const std::string& source, std::int64_t stamp_ns) {
+  msg::RobotCommand c;
+  c.robot_id(robot_id);
+  c.kind(kind);
+  c.value(value);
+  set(c.target(), target);
+  c.source(source);
+  c.stamp_ns(stamp_ns);
+  return c;
+}
+
 msg::RobotState state_msg(const std::string& robot_id, const ArmSim& arm, std::int64_t stamp_ns) {
   msg::RobotState s;
   s.robot_id(robot_id);

@@ -85,13 +85,8 @@ void SeparationComponent::on_start() {
 }
 
 void SeparationComponent::command(msg::RobotCommandKind kind, double value) {
-  msg::RobotCommand c;
-  c.robot_id(robot_id_);
-  c.kind(kind);
-  c.value(value);
-  c.source(ctx_.name());
-  c.stamp_ns(ctx_.clock().now_ns());
-  if (command_pub_.publish(c)) ++commands_;
+  if (command_pub_.publish(command_msg(robot_id_, kind, value, Eigen::Vector3d::Zero(), ctx_.name(), ctx_.clock().now_ns())))
+    ++commands_;
   else ++failed_writes_;
 }
 

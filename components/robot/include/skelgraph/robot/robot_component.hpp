@@ -51,5 +51,8 @@ Eigen::Vector3d parse_point(const std::string& text);
 Joints parse_joints_deg(const std::string& text);
 // The state message of an arm.
 msg::RobotState state_msg(const std::string& robot_id, const ArmSim& arm, std::int64_t stamp_ns);
+// A command to a robot (the one message every commanding component sends).
+msg::RobotCommand command_msg(const std::string& robot_id, msg::RobotCommandKind kind, double value,
+                              const Eigen::Vector3d& target, const std::string& source, std::int64_t stamp_ns);
 
 }  // namespace skelgraph::robot
