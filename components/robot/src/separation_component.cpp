@@ -7,6 +7,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "skelgraph/robot/robot_component.hpp"
 #include "skelgraph/runtime/topics.hpp"
 #include "skelgraph/skeleton/skeleton_msg.hpp"
 
