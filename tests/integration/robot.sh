@@ -112,6 +112,18 @@ assert math.dist(robot["tool"], f["target"]) < 0.03, (robot["tool"], f["target"]
 print("ok: fetch: %d pointing events, the tool sent once to hover above the spot and now %.3f m from it" % (f["events"], math.dist(robot["tool"], f["target"])))
 PY
 
+# The offline measurements as a user runs them (short), and bad input said plainly.
+"$SKELGRAPH" eval safety --seeds 1 --people 2 --repeats 1 --dropout sensor2,10,3 --json >"$WORK/safety.json" 2>/dev/null || fail "eval safety"
+json_check "$WORK/safety.json" 'len(d["runs"]) == 1 and d["runs"][0]["people"] == 2 and d["total"]["seconds"] > 10 and d["total"]["missed_steps"] == 0 and d["total"]["stops"] >= 1'
+"$SKELGRAPH" eval fetch --sessions 2 --json >"$WORK/fetch_eval.json" 2>/dev/null || fail "eval fetch"
+json_check "$WORK/fetch_eval.json" 'd["pointing"] == 12 and d["fetched"] <= d["spotted"] <= d["in_reach"] <= d["pointing"]'
+for bad in "--dropout sensor9,10,3" "--dropout sensor1,3,10" "-p sensor_count=2 -p sensor_count=3"; do
+  # shellcheck disable=SC2086
+  if "$SKELGRAPH" eval safety --repeats 1 $bad >/dev/null 2>"$WORK/bad.err"; then fail "eval safety $bad was accepted"; fi
+  grep -q "error:" "$WORK/bad.err" || fail "eval safety $bad: no error message: $(cat "$WORK/bad.err")"
+done
+ok "eval safety and eval fetch: JSON as documented; bad --dropout and parameters refused with a message"
+
 # Fail-safe: a robot and its monitor with no sensors at all.
 cat >"$WORK/no_people.yaml" <<'YAML'
 components:
