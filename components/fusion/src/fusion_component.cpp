@@ -87,17 +87,22 @@ std::map<std::string, std::int64_t> latencies_from(const runtime::Params& p) {
   return out;
 }
 
-FuserOptions options_with_latency(const runtime::Params& p) {
+// The fuser with its options and each sensor's capture latency (the list parsed once).
+Fuser make_fuser(const runtime::Params& p) {
   auto o = options_from(p);
-  const auto l = latencies_from(p);
-  if (l.count("")) o.capture_latency_ns = l.at("");
-  return o;
+  const auto latencies = latencies_from(p);
+  if (latencies.count("")) o.capture_latency_ns = latencies.at("");
+  Fuser f(o);
+  for (const auto& [sensor, ns] : latencies) {
+    if (!sensor.empty()) f.set_capture_latency(sensor, ns);
+  }
+  return f;
 }
 }  // namespace
 
 FusionComponent::FusionComponent(runtime::Context& ctx, const runtime::Params& params)
     : Component(ctx),
-      fuser_(options_with_latency(params)),
+      fuser_(make_fuser(params)),
       output_id_(params.get<std::string>("output_id")),
       period_ns_(static_cast<std::int64_t>(1e9 / params.get<double>("rate_hz"))),
       trigger_(params.get<std::string>("trigger")),
@@ -136,11 +141,7 @@ FusionComponent::FusionComponent(runtime::Context& ctx, const runtime::Params& p
         last_tick_ns_ = meta.receive_ns;
         ++tick_steps_;
         step(meta.receive_ns);
-      }) {
-  for (const auto& [sensor, ns] : latencies_from(params)) {
-    if (!sensor.empty()) fuser_.set_capture_latency(sensor, ns);
-  }
-}
+      }) {}
 
 void FusionComponent::on_start() {
   timer_ = ctx_.executor().every(std::chrono::nanoseconds(period_ns_), [this] {
