@@ -64,24 +64,27 @@ YAML
 "$SKELGRAPH" launch "$WORK/robot_rec.yaml" --duration 4 >/dev/null 2>"$WORK/rec.err" || fail "robot recording: $(tail -5 "$WORK/rec.err")"
 rec=$(ls "$WORK"/rec/*.mcap | head -1)
 "$SKELGRAPH" bag info "$rec" --json >"$WORK/rec_info.json" || fail "bag info $rec"
-"$SKELGRAPH" topic echo skelgraph/robot/state --json >"$WORK/replayed_state.jsonl" 2>/dev/null &
+n_state=$(python3 -c 'import json,sys; print({t["topic"]: t["count"] for t in json.load(open(sys.argv[1]))["topics"]}.get("skelgraph/robot/state", 0))' "$WORK/rec_info.json")
+n_safety=$(python3 -c 'import json,sys; print({t["topic"]: t["count"] for t in json.load(open(sys.argv[1]))["topics"]}.get("skelgraph/safety", 0))' "$WORK/rec_info.json")
+# The recording played in a loop until the readers have as many samples as it holds (each echo ends at its count).
+"$SKELGRAPH" topic echo skelgraph/robot/state --json --count "$n_state" --timeout 60 >"$WORK/replayed_state.jsonl" 2>/dev/null &
 echo_pid=$!
-"$SKELGRAPH" topic echo skelgraph/safety --json >"$WORK/replayed_safety.jsonl" 2>/dev/null &
+"$SKELGRAPH" topic echo skelgraph/safety --json --count "$n_safety" --timeout 60 >"$WORK/replayed_safety.jsonl" 2>/dev/null &
 echo2_pid=$!
-sleep 2
-"$SKELGRAPH" bag play "$rec" --topics skelgraph/robot/state skelgraph/safety --json >"$WORK/play.json" 2>/dev/null || fail "bag play $rec"
-sleep 1
-kill "$echo_pid" "$echo2_pid" 2>/dev/null || true
-wait "$echo_pid" "$echo2_pid" 2>/dev/null || true
+"$SKELGRAPH" bag play "$rec" --loop --topics skelgraph/robot/state skelgraph/safety >/dev/null 2>&1 &
+play_pid=$!
+wait "$echo_pid" "$echo2_pid" || true
+kill "$play_pid" 2>/dev/null || true
+wait "$play_pid" 2>/dev/null || true
 python3 - "$WORK/rec_info.json" "$WORK/replayed_state.jsonl" "$WORK/replayed_safety.jsonl" <<'PY' || fail "robot topics recorded and replayed"
 import json, sys
 topics = {t["topic"]: t["count"] for t in json.load(open(sys.argv[1]))["topics"]}
 assert topics.get("skelgraph/robot/state", 0) > 200 and topics.get("skelgraph/safety", 0) > 10 and topics.get("skelgraph/robot/command", 0) >= 1, topics
 state = [json.loads(l)["data"] for l in open(sys.argv[2])]
 safety = [json.loads(l)["data"] for l in open(sys.argv[3])]
-# Everything recorded comes back (a keep-last reader may merge a few samples on a busy machine, so at least 90 %).
-assert len(state) >= 0.9 * topics["skelgraph/robot/state"] and all(s["robot_id"] == "robot1" and len(s["capsules"]) == 7 for s in state), len(state)
-assert len(safety) >= 0.9 * topics["skelgraph/safety"], (len(safety), topics["skelgraph/safety"])
+# As many samples as recorded come back, as recorded.
+assert len(state) == topics["skelgraph/robot/state"] and all(s["robot_id"] == "robot1" and len(s["capsules"]) == 7 for s in state), len(state)
+assert len(safety) == topics["skelgraph/safety"] and all(x["robot_id"] == "robot1" and x["state"] for x in safety), (len(safety), topics["skelgraph/safety"])
 print("ok: robot topics recorded (%s) and replayed (%d states, %d safety verdicts)" % (
     {k: v for k, v in topics.items() if "robot" in k or "safety" in k}, len(state), len(safety)))
 PY
@@ -97,7 +100,7 @@ components:
 YAML
 "$SKELGRAPH" launch "$WORK/fetch.yaml" --duration 9 --json >"$WORK/fetch.json" 2>"$WORK/fetch.err" &
 fetch_launch=$!
-sleep 1
+wait_for_match "$WORK/fetch.err" "\[start\] fetch" 20 || fail "fetch did not start: $(tail -5 "$WORK/fetch.err")"
 "$PUBLISH_GESTURE" 6 2>/dev/null
 wait "$fetch_launch" || fail "fetch launch: $(tail -5 "$WORK/fetch.err")"
 python3 - "$WORK/fetch.json" <<'PY' || fail "fetch: $(head -c 3000 "$WORK/fetch.json")"
