@@ -80,12 +80,15 @@ try {
   out.uncertainty = { before: spheres(u0), hidden: spheres(u1), restored: spheres(u2) };
 
   // Pause freezes the view while frames keep arriving.
+  // Waits on what arrives, not on time: a busy machine delivers fewer frames a second.
   await page.click('#pause');
   const p0 = await stats();
-  await sleep(1000);
+  await page.waitForFunction((n) => window.skelgraphViewer.framesReceived >= n, p0.framesReceived + 20,
+                             { timeout: 15000 }).catch(() => {});
   const p1 = await stats();
   await page.click('#pause');
-  await sleep(500);
+  await page.waitForFunction((n) => window.skelgraphViewer.framesDrawn > n, p1.framesDrawn,
+                             { timeout: 15000 }).catch(() => {});
   const p2 = await stats();
   out.pause = { drawn_while_paused: p1.framesDrawn - p0.framesDrawn, received_while_paused: p1.framesReceived - p0.framesReceived,
                 drawn_after_resume: p2.framesDrawn - p1.framesDrawn };

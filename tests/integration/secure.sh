@@ -94,7 +94,21 @@ grep -q "^secure_" "$WORK/files.txt" || fail "no secure session recorded: $(cat 
 if grep -q "^session_" "$WORK/files.txt"; then fail "a recorder obeyed a stranger's START: $(cat "$WORK/files.txt")"; fi
 "$SKELGRAPH" bag merge "$WORK"/{fusion,sensor1,sensor2}/recordings/secure_*.mcap --out "$WORK/merged.mcap" >/dev/null
 "$SKELGRAPH" bag info "$WORK/merged.mcap" --json >"$WORK/info.json"
-json_check "$WORK/info.json" 'all(d["ticks_acked_by_host"].get(h) == '"$(json_get "$WORK/stop.json" 'd["tick"]')"' for h in ("fusion", "sensor1", "sensor2"))'
+# Every tick acked by every host; a recorder that launch started over within the session (a stuck
+# authentication, docs/security.md; it goes on in a second file) misses at most the ticks of its
+# restart (2 s).
+ticks=$(json_get "$WORK/stop.json" 'd["tick"]')
+for h in fusion sensor1 sensor2; do
+  files=$(ls "$WORK/$h"/recordings/secure_*.mcap | wc -l)
+  acked=$(json_get "$WORK/info.json" 'd["ticks_acked_by_host"].get("'"$h"'", 0)')
+  if [ "$files" -eq 1 ]; then
+    [ "$acked" -eq "$ticks" ] || fail "$h acked $acked of $ticks ticks"
+  else
+    grep -q "restarting it with a new DDS participant" "$WORK/$h.err" || fail "$h: $files files but no restart reported"
+    [ "$acked" -ge $((ticks - 30)) ] || fail "$h acked $acked of $ticks ticks across its restart"
+    echo "  $h: recorder started over within the session ($files files), $acked of $ticks ticks acked"
+  fi
+done
 ok "no credentials / another CA: read nothing, started no recording; read-only host reads but its sync master is refused"
 
 # 3. The wire: encrypted. No topic or type name (discovery and status data name them in the clear on lan).
