@@ -168,3 +168,50 @@ print("live fusion on the calibration file: %.1f cm from the truth (sensor1 alon
       % (live["mean_error_cm"], s["sensor1"]["mean_error_cm"]))
 PY
 ok "fusion_calibrated.yaml scored live (eval live): fused skeletons in the world frame of the calibration file"
+
+# Sensors into the robot's frame: a board on a simulated UR5e's tool, 20 poses facing each sensor of a ring of four.
+"$S" sim boards "$WORK/robot" --robot 0,0,1,180 -p layout=ring -p sensor_count=4 --json >"$WORK/robot_boards.json" ||
+  fail "sim boards --robot"
+json_check "$WORK/robot_boards.json" 'all(v >= 20 for v in d["views"].values()) and len(d["views"]) == 4'
+"$S" calib robot "$WORK"/robot/sensor{1,2,3,4} --tool-poses "$WORK/robot/tool_poses.yaml" --base 0,0,1,180 \
+  --truth "$WORK/robot/truth.yaml" --out "$WORK/robot_cal.yaml" --json >"$WORK/robot_cal.json" 2>"$WORK/robot_cal.err" ||
+  fail "calib robot: $(cat "$WORK/robot_cal.err") $(head -c 1500 "$WORK/robot_cal.json")"
+json_check "$WORK/robot_cal.json" 'd["worst_error_deg"] <= 0.5 and d["worst_error_cm"] <= 1.0 and len(d["sensors"]) == 4 and not d["failed"] and all(s["verdict"].startswith("good") for s in d["sensors"])'
+grep -c "method: robot_board" "$WORK/robot_cal.yaml" | grep -qx 4 || fail "calibration file: $(cat "$WORK/robot_cal.yaml")"
+ok "board on the tool: 4 sensors within $(json_get "$WORK/robot_cal.json" 'round(d["worst_error_deg"], 2)') deg and $(json_get "$WORK/robot_cal.json" 'round(d["worst_error_cm"], 2)') cm of the truth"
+# A view whose tool pose is missing is skipped and named; a sensor that sees the board in too few views gets no pose.
+mkdir -p "$WORK/robot/few" && cp "$WORK"/robot/sensor1/00{0,1}_* "$WORK/robot/sensor1/intrinsics.yaml" "$WORK/robot/few/"
+cp "$WORK/robot/sensor1/002_color.png" "$WORK/robot/few/999_color.png" && cp "$WORK/robot/sensor1/002_depth.png" "$WORK/robot/few/999_depth.png"
+if "$S" calib robot "$WORK/robot/few" --tool-poses "$WORK/robot/tool_poses.yaml" --base 0,0,1,180 --json >"$WORK/few.json" 2>/dev/null; then
+  fail "a sensor with two usable views was calibrated"
+fi
+json_check "$WORK/few.json" 'd["failed"] and "only 2 views" in d["failed"][0] and "999: no tool pose" in d["failed"][0] and not d["sensors"]'
+# Bad tool poses files: file:line and what was expected.
+printf 'version: 1\nboard_on_tool: {translation: [0, 0], rotation_xyzw: [0, 0, 0, 1]}\nviews: []\n' >"$WORK/bad_poses.yaml"
+"$S" calib robot "$WORK/robot/sensor1" --tool-poses "$WORK/bad_poses.yaml" 2>"$WORK/bad.err" && fail "a bad tool poses file was accepted"
+grep -q "bad_poses.yaml:2:.*'translation' expects a list of 3 numbers" "$WORK/bad.err" || fail "bad tool poses: $(cat "$WORK/bad.err")"
+"$S" calib robot --tool-poses "$WORK/robot/tool_poses.yaml" 2>"$WORK/bad.err" && fail "no view directories accepted"
+grep -q "needs one or more view directories" "$WORK/bad.err" || fail "no directories: $(cat "$WORK/bad.err")"
+ok "calib robot: a missing tool pose named, too few views refused, bad files named by line"
+
+# A hand held at the tool: what it reaches is reported, judged and never written as good when it is not.
+"$S" sim hand-at-tool "$WORK/hand.mcap" -p scenario=arms -p layout=ring -p sensor_count=4 --json >"$WORK/hand_sim.json" ||
+  fail "sim hand-at-tool"
+"$S" sim poses "$WORK/ring4.yaml" -p layout=ring -p sensor_count=4 >/dev/null
+rc=0
+"$S" calib robot --hand "$WORK/hand.mcap" --base 0,0,1.5,180 --truth "$WORK/ring4.yaml" --json >"$WORK/hand.json" 2>"$WORK/hand.err" || rc=$?
+python3 - "$WORK/hand.json" "$rc" <<'PY' || fail "calib robot --hand: $(head -c 2000 "$WORK/hand.json") $(cat "$WORK/hand.err")"
+import json, sys
+d, rc = json.load(open(sys.argv[1])), int(sys.argv[2])
+assert len(d["sensors"]) + len(d["failed"]) == 4, d
+for s in d["sensors"]:
+    assert s["places"] >= 6 and s["holds"] >= s["places"], s         # the arms scenario's reaches, held still
+    assert s["places_agreeing"] <= s["places"], s
+    good = s["verdict"].startswith("good")
+    assert good == (s["rms_residual_cm"] < 4 and s["places_agreeing"] * 10 >= s["places"] * 8), s
+assert rc == (0 if all(s["verdict"].startswith("good") for s in d["sensors"]) and not d["failed"] else 1), rc
+print("hand at the tool:", [(s["sensor"], round(s["error_deg"], 1), round(s["error_cm"], 1), s["verdict"][:4]) for s in d["sensors"]])
+PY
+"$S" calib robot --hand "$WORK/robot_cal.yaml" 2>"$WORK/bad.err" && fail "a YAML file was read as a recording"
+grep -q "robot_cal.yaml" "$WORK/bad.err" || fail "not a recording: $(cat "$WORK/bad.err")"
+ok "hand at the tool: holds found at the reaches, the verdict follows the residuals"

@@ -641,3 +641,111 @@ TEST(Board, TwentyViewsGiveTheExtrinsics) {
   EXPECT_LT(angle, 0.5);
   EXPECT_LT(dist, 0.01);
 }
+
+// --- Sensors into a robot's frame (robot_calib.hpp) ---
+#include "skelgraph/calib/robot_calib.hpp"
+
+namespace {
+
+Eigen::Isometry3d iso(const Matrix3d& R, const Vector3d& t) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = R;
+  T.translation() = t;
+  return T;
+}
+
+// A 9x6 board's inner corners, 8 cm squares (Board::object_points()).
+std::vector<Vector3d> board_corners() {
+  std::vector<Vector3d> p;
+  for (int r = 0; r < 6; ++r) {
+    for (int c = 0; c < 9; ++c) p.emplace_back(0.08 * c, 0.08 * r, 0.0);
+  }
+  return p;
+}
+
+}  // namespace
+
+TEST(RobotCalib, ABoardOnTheToolPlacesTheSensorInTheBaseFrame) {
+  const Eigen::Isometry3d base_from_sensor = iso(rot(150, 10, 0), Vector3d(1.8, 0.6, 1.1));
+  const Eigen::Isometry3d base_from_camera = iso(base_from_sensor.linear() * calib::sensor_from_camera(),
+                                                 base_from_sensor.translation());
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> noise(0.0, 0.002);  // 2 mm of lifting noise per corner
+  std::vector<std::vector<Vector3d>> corners;
+  std::vector<Eigen::Isometry3d> boards;
+  for (int v = 0; v < 12; ++v) {
+    const Eigen::Isometry3d base_from_board = iso(rot(20.0 * v, 15.0 * (v % 3), 5.0 * v), Vector3d(0.4 + 0.03 * v, 0.5, 0.3 - 0.02 * v));
+    std::vector<Vector3d> in_camera;
+    for (const auto& p : board_corners()) {
+      in_camera.push_back(base_from_camera.inverse() * (base_from_board * p) + Vector3d(noise(rng), noise(rng), noise(rng)));
+    }
+    corners.push_back(in_camera);
+    boards.push_back(base_from_board);
+  }
+  // One view whose reported tool pose is 20 cm off (a pose typed wrong): its corners are left out.
+  boards[4].translation() += Vector3d(0.2, 0, 0);
+  const auto fit = calib::fit_board_on_tool(corners, boards, board_corners());
+  EXPECT_EQ(fit.views, 12u);
+  EXPECT_EQ(fit.points, 12u * 54u);
+  EXPECT_LE(fit.ransac.inliers.size(), 11u * 54u + 2u);
+  EXPECT_GE(fit.ransac.inliers.size(), 11u * 54u - 5u);
+  EXPECT_LT(calib::rotation_angle_deg(fit.base_from_sensor.linear() * base_from_sensor.linear().transpose()), 0.1);
+  EXPECT_LT((fit.base_from_sensor.translation() - base_from_sensor.translation()).norm(), 0.003);
+  // Too few views, and views that do not match the tool poses: clear errors.
+  EXPECT_NE(error_of([&] { calib::fit_board_on_tool({corners[0], corners[1]}, {boards[0], boards[1]}, board_corners()); })
+                .find("only 2 views"),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { calib::fit_board_on_tool(corners, {boards[0]}, board_corners()); }).find("1 tool poses"),
+            std::string::npos);
+}
+
+TEST(RobotCalib, HoldsAreWhereTheToolAndTheHandStandStill) {
+  // The tool stops at five places for 1.5 s each, moving 0.5 m/s in between;
+  // the hand joint follows it, 3 cm off, with 3 cm of tracker jitter; at the
+  // fourth stop the hand has gone (the person let go).
+  const std::vector<Vector3d> stops{{0.5, 0.3, 0.2}, {0.2, 0.6, 0.4}, {-0.3, 0.4, 0.5}, {-0.1, 0.9, 0.3}, {0.4, 0.8, 0.6}};
+  std::vector<calib::TimedPoint> tool, hand;
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> jitter(0.0, 0.03);
+  std::int64_t t = 0;
+  const std::int64_t dt = 33'333'333;
+  for (std::size_t s = 0; s < stops.size(); ++s) {
+    const Vector3d from = s == 0 ? Vector3d(0, 0, 0) : stops[s - 1];
+    const int travel = static_cast<int>((stops[s] - from).norm() / 0.5 * 30);
+    for (int i = 0; i <= travel + 45; ++i, t += dt) {
+      const Vector3d p = i < travel ? Vector3d(from + (stops[s] - from) * (double(i) / travel)) : stops[s];
+      tool.push_back({t, p});
+      if (s == 3 && i >= travel) continue;  // no hand while the tool stands at the fourth stop
+      hand.push_back({t + 5'000'000, p + Vector3d(0.03, 0, 0) + Vector3d(jitter(rng), jitter(rng), jitter(rng))});
+    }
+  }
+  const auto holds = calib::find_holds(tool, hand);
+  ASSERT_EQ(holds.size(), 4u);
+  const std::vector<std::size_t> at{0, 1, 2, 4};
+  for (std::size_t i = 0; i < holds.size(); ++i) {
+    EXPECT_LT((holds[i].tool - stops[at[i]]).norm(), 1e-9) << i;
+    EXPECT_LT((holds[i].hand - stops[at[i]] - Vector3d(0.03, 0, 0)).norm(), 0.03) << i;  // a median of 40 jittered samples
+    EXPECT_GE(holds[i].end_ns - holds[i].start_ns, 1'000'000'000) << i;
+  }
+}
+
+TEST(RobotCalib, AHandAtTheToolGivesARoughPoseAndLeavesOutAHandElsewhere) {
+  const Eigen::Isometry3d base_from_sensor = iso(rot(-70, 5, 0), Vector3d(-1.5, 0.8, 0.9));
+  std::mt19937_64 rng(9);
+  std::normal_distribution<double> bias(0.0, 0.01);
+  std::vector<calib::Hold> holds;
+  for (const auto& p : cloud(12, 4)) {
+    calib::Hold h;
+    h.tool = 0.4 * p + Vector3d(0.3, 0.6, 0.3);  // within an arm's reach
+    h.hand = base_from_sensor.inverse() * (h.tool + Vector3d(bias(rng), bias(rng), bias(rng)));
+    holds.push_back(h);
+  }
+  holds[7].hand += Vector3d(0.4, -0.3, 0.1);  // the other hand, or someone else's
+  const auto fit = calib::fit_hand_at_tool(holds);
+  EXPECT_EQ(fit.ransac.inliers.size(), 11u);
+  EXPECT_EQ(std::count(fit.ransac.inliers.begin(), fit.ransac.inliers.end(), 7u), 0);
+  EXPECT_LT(calib::rotation_angle_deg(fit.base_from_sensor.linear() * base_from_sensor.linear().transpose()), 5.0);
+  EXPECT_LT((fit.base_from_sensor.translation() - base_from_sensor.translation()).norm(), 0.05);
+  holds.resize(3);
+  EXPECT_NE(error_of([&] { calib::fit_hand_at_tool(holds); }).find("need 4 or more"), std::string::npos);
+}

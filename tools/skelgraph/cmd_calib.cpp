@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -22,6 +23,7 @@
 #include "skelgraph/mcap/mcap.hpp"
 #include "skelgraph/msg/cdr.hpp"
 #include "skelgraph/playback/readers.hpp"
+#include "skelgraph/robot/robot_component.hpp"
 #include "skelgraph/runtime/topics.hpp"
 #include "skelgraph/sim/simulation.hpp"
 #include "skelgraph/skeleton/skeleton_msg.hpp"
@@ -720,6 +722,33 @@ calib::Intrinsics intrinsics_for(const std::string& dir, const std::string& give
   }
 }
 
+// One view NAME in DIR: the board's corners found in NAME_color.png and
+// lifted to 3-D (camera frame) with NAME_depth.png; nothing, with the reason
+// in `why`, when the view is missing or the board is not usable in it.
+std::optional<std::vector<Eigen::Vector3d>> lift_view(const std::string& dir, const std::string& name,
+                                                      const calib::Board& board, const calib::Intrinsics& k,
+                                                      std::string* why) {
+  const std::filesystem::path d = dir;
+  const auto colour = (d / (name + "_color.png")).string(), depth = (d / (name + "_depth.png")).string();
+  if (!std::filesystem::exists(colour) || !std::filesystem::exists(depth)) {
+    *why = name + ": no colour and depth image in " + dir;
+    return std::nullopt;
+  }
+  const auto corners = calib::find_corners(read_image(colour, cv::IMREAD_GRAYSCALE), board);
+  if (!corners) {
+    *why = name + ": board not found in " + colour;
+    return std::nullopt;
+  }
+  const cv::Mat dm = read_image(depth, cv::IMREAD_ANYDEPTH);
+  if (dm.type() != CV_16U) throw UsageError(depth + ": expected a 16-bit depth image (millimetres)");
+  try {
+    return calib::lift_corners(*corners, dm, k, board).points;
+  } catch (const calib::CalibError& e) {
+    *why = name + ": " + e.what();
+    return std::nullopt;
+  }
+}
+
 int calib_board(const BoardOptions& o) {
   const auto board = board_of(o);
   // Two directories: the other sensor against the reference. One directory
@@ -755,27 +784,14 @@ int calib_board(const BoardOptions& o) {
       ok = false;
     }
     for (std::size_t c = 0; c < dirs.size() && ok; ++c) {
-      const std::filesystem::path dir = dirs[c];
-      const auto colour = (dir / (n + "_color.png")).string(), depth = (dir / (n + "_depth.png")).string();
-      if (!std::filesystem::exists(colour) || !std::filesystem::exists(depth)) {
+      std::string why;
+      auto points = lift_view(dirs[c], n, board, ks[c], &why);
+      if (!points) {
         ok = false;
-        skipped.push_back(n + (world ? ": no colour and depth image" : ": not in both directories with colour and depth"));
+        skipped.push_back(why);
         break;
       }
-      const auto corners = calib::find_corners(read_image(colour, cv::IMREAD_GRAYSCALE), board);
-      if (!corners) {
-        ok = false;
-        skipped.push_back(n + ": board not found in " + colour);
-        break;
-      }
-      const cv::Mat d = read_image(depth, cv::IMREAD_ANYDEPTH);
-      if (d.type() != CV_16U) throw UsageError(depth + ": expected a 16-bit depth image (millimetres)");
-      try {
-        lifted[c] = calib::lift_corners(*corners, d, ks[c], board).points;
-      } catch (const calib::CalibError& e) {
-        ok = false;
-        skipped.push_back(n + ": " + e.what());
-      }
+      lifted[c] = std::move(*points);
     }
     progress("views: " + std::to_string(i + 1) + " of " + std::to_string(names.size()) + " read", i + 1 == names.size());
     if (!ok) continue;
@@ -871,6 +887,258 @@ int calib_board(const BoardOptions& o) {
     for (const auto& s : skipped) std::printf("  skipped %s\n", s.c_str());
   }
   return good ? 0 : 1;
+}
+
+
+struct RobotOptions {
+  std::vector<std::string> dirs;  // board on the tool: one directory of views per sensor
+  std::string tool_poses;         // ... and what the robot reported for each view
+  std::string hand_recording;     // hand at the tool: a recording of robot/state and skeleton/raw
+  std::string hand = "either";
+  std::string intrinsics;         // for every directory (default DIR/intrinsics.yaml)
+  std::string base = "0,0,1.5,180";
+  std::string size = "9x6";
+  double square_m = 0.08, hold_s = 1.0, inlier_cm = 8.0;
+  std::string truth, out;
+  bool json = false;
+};
+
+// Hand at the tool: the recording's tool positions (robot/state, world) and
+// each sensor's hand joint (skeleton/raw, sensor frame), per sensor and
+// tracked person, on the recorder's clock (log time): the sensors' and the
+// robot's own stamps need not share a clock.
+struct HandInput {
+  std::vector<calib::TimedPoint> tool;
+  // sensor -> (person, hand) -> positions
+  std::map<std::string, std::map<std::pair<std::uint32_t, int>, std::vector<calib::TimedPoint>>> hands;
+  std::size_t states = 0;
+};
+
+HandInput read_hand_input(const std::string& path, const std::vector<skeleton::JointId>& joints) {
+  HandInput in;
+  try {
+    const mcap::Reader reader(path);
+    reader.for_each_message([&](const mcap::Channel& ch, const mcap::Schema* schema, const mcap::Message& m) {
+      if (schema == nullptr) return;
+      const auto* bytes = reinterpret_cast<const std::uint8_t*>(m.data.data());
+      if (ch.topic == runtime::topics::kRobotState.name && schema->name == msg::MessageTraits<msg::RobotState>::name) {
+        const auto st = msg::from_cdr<msg::RobotState>(bytes, m.data.size());
+        const auto& p = st.tool_position();
+        in.tool.push_back({static_cast<std::int64_t>(m.log_time), {p.x(), p.y(), p.z()}});
+        ++in.states;
+      } else if (ch.topic == runtime::topics::kSkeletonRaw.name && schema->name == msg::MessageTraits<msg::Skeleton>::name) {
+        const auto s = skeleton::from_msg(msg::from_cdr<msg::Skeleton>(bytes, m.data.size()));
+        for (std::size_t k = 0; k < joints.size(); ++k) {
+          const auto& j = s[joints[k]];
+          if (j.confidence < 0.5f) continue;  // inferred: not where the hand is
+          in.hands[s.sensor_id][{s.person_id, static_cast<int>(k)}].push_back({static_cast<std::int64_t>(m.log_time), j.position});
+        }
+      }
+    });
+  } catch (const mcap::McapError& e) {
+    throw UsageError(e.what());
+  }
+  const auto by_time = [](const calib::TimedPoint& a, const calib::TimedPoint& b) { return a.t_ns < b.t_ns; };
+  std::sort(in.tool.begin(), in.tool.end(), by_time);
+  for (auto& [s, people] : in.hands) {
+    for (auto& [id, pts] : people) std::sort(pts.begin(), pts.end(), by_time);
+  }
+  if (in.states == 0) throw UsageError(path + ": no skelgraph/robot/state messages (record the robot with the people)");
+  if (in.hands.empty()) throw UsageError(path + ": no skelgraph/skeleton/raw skeletons with a tracked hand");
+  return in;
+}
+
+int calib_robot(const RobotOptions& o) {
+  const bool hand_mode = !o.hand_recording.empty();
+  if (hand_mode == !o.tool_poses.empty()) {
+    throw UsageError("give either --tool-poses with one view directory per sensor (a board on the tool), or --hand "
+                     "RECORDING (a hand held at the tool)");
+  }
+  if (!hand_mode && o.dirs.empty()) throw UsageError("--tool-poses needs one or more view directories (one per sensor, named by its id)");
+  if (hand_mode && !o.dirs.empty()) throw UsageError("--hand takes no view directories");
+  Eigen::Isometry3d world_from_base;
+  try {
+    world_from_base = robot::parse_base(o.base);
+  } catch (const std::exception& e) {
+    throw UsageError(std::string("--base: ") + e.what());
+  }
+  std::map<std::string, Eigen::Isometry3d> truth;
+  if (!o.truth.empty()) truth = prior_poses(o.truth);
+
+  struct Result {
+    std::string sensor;
+    calib::RobotFit fit;
+    std::vector<std::string> skipped;
+    std::size_t offered = 0;  // views (board) or holds (hand)
+    std::size_t places = 0, places_agreeing = 0;  // hand: where the tool held still, and where a hand agreed
+  };
+  std::vector<Result> results;
+  std::vector<std::string> failed;  // sensors without a fit, with the reason
+  if (hand_mode) {
+    // Either hand by default: a tracker that sees the person's back swaps left and right,
+    // and the hand not at the tool is an outlier RANSAC leaves out.
+    std::vector<skeleton::JointId> joints;
+    if (o.hand != "left") joints.push_back(skeleton::JointId::RightHand);
+    if (o.hand != "right") joints.push_back(skeleton::JointId::LeftHand);
+    const auto in = read_hand_input(o.hand_recording, joints);
+    calib::HoldOptions ho;
+    ho.hold_s = o.hold_s;
+    for (const auto& [sensor, people] : in.hands) {
+      std::vector<calib::Hold> holds;
+      for (const auto& [id, pts] : people) {
+        const auto h = calib::find_holds(in.tool, pts, ho);
+        holds.insert(holds.end(), h.begin(), h.end());
+      }
+      // The tool's positions are in the world the robot reports in: to its base.
+      for (auto& h : holds) h.tool = world_from_base.inverse() * h.tool;
+      // The places the tool held still at (both hands may pair with one).
+      const auto places = [&](const std::vector<std::size_t>& which) {
+        std::vector<Eigen::Vector3d> out;
+        for (std::size_t i : which) {
+          if (std::none_of(out.begin(), out.end(), [&](const Eigen::Vector3d& p) { return (p - holds[i].tool).norm() < ho.min_gap_m; })) {
+            out.push_back(holds[i].tool);
+          }
+        }
+        return out.size();
+      };
+      try {
+        Result r{sensor, calib::fit_hand_at_tool(holds, o.inlier_cm / 100.0), {}, holds.size()};
+        std::vector<std::size_t> all(holds.size());
+        for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
+        r.places = places(all);
+        r.places_agreeing = places(r.fit.ransac.inliers);
+        results.push_back(std::move(r));
+      } catch (const calib::CalibError& e) {
+        failed.push_back(sensor + ": " + e.what());
+      }
+    }
+  } else {
+    calib::ToolPoses poses;
+    try {
+      poses = calib::read_tool_poses(o.tool_poses);
+    } catch (const calib::CalibFileError& e) {
+      throw UsageError(e.what());
+    }
+    calib::Board board;
+    try {
+      board = calib::Board::parse(o.size, o.square_m);
+    } catch (const calib::CalibError& e) {
+      throw UsageError(e.what());
+    }
+    Progress progress(!o.json);
+    for (const auto& dir : o.dirs) {
+      const std::string sensor = std::filesystem::path(dir).filename().string();
+      const auto k = intrinsics_for(dir, o.intrinsics);
+      std::vector<std::vector<Eigen::Vector3d>> corners;
+      std::vector<Eigen::Isometry3d> base_from_board;
+      std::vector<std::string> skipped;
+      const auto names = view_names(dir);
+      for (std::size_t i = 0; i < names.size(); ++i) {
+        const auto& n = names[i];
+        const auto pose = poses.base_from_tool.find(n);
+        std::string why;
+        if (pose == poses.base_from_tool.end()) {
+          skipped.push_back(n + ": no tool pose for this view in " + o.tool_poses);
+        } else if (auto pts = lift_view(dir, n, board, k, &why)) {
+          corners.push_back(std::move(*pts));
+          base_from_board.push_back(pose->second * poses.tool_from_board);
+        } else {
+          skipped.push_back(why);
+        }
+        progress(sensor + ": " + std::to_string(i + 1) + " of " + std::to_string(names.size()) + " views read", i + 1 == names.size());
+      }
+      try {
+        results.push_back({sensor, calib::fit_board_on_tool(corners, base_from_board, board.object_points()), skipped, names.size()});
+      } catch (const calib::CalibError& e) {
+        failed.push_back(sensor + ": " + e.what() + (skipped.empty() ? "" : " (" + skipped.front() + ")"));
+      }
+    }
+  }
+
+  // Verdicts: the board's corners agree within 1 cm RMS with few outliers; a
+  // hand (a joint a few cm from the touch, and a tracker's noise) within 4 cm.
+  const double good_rms_m = hand_mode ? 0.04 : 0.01;
+  nlohmann::json sensors = nlohmann::json::array();
+  calib::CalibFile file;
+  file.comment = std::string("written by skelgraph calib robot ") +
+                 (hand_mode ? "--hand " + o.hand_recording : "--tool-poses " + o.tool_poses) + " --base " + o.base;
+  bool all_good = failed.empty() && !results.empty();
+  for (const auto& r : results) {
+    const auto& f = r.fit.ransac.fit;
+    const bool good = f.rms < good_rms_m && (hand_mode ? r.places_agreeing * 10 >= r.places * 8
+                                                       : r.fit.ransac.inliers.size() * 10 >= r.fit.points * 8);
+    all_good = all_good && good;
+    const Eigen::Isometry3d world_from_sensor = world_from_base * r.fit.base_from_sensor;
+    nlohmann::json j{{"sensor", r.sensor}, {hand_mode ? "holds" : "views", r.offered}, {"used", r.fit.views},
+                     {"points", r.fit.points}, {"inliers", r.fit.ransac.inliers.size()},
+                     {"rms_residual_cm", cm(f.rms)}, {"max_residual_cm", cm(f.max)},
+                     {"base_from_sensor", pose_json(r.fit.base_from_sensor)}, {"world_from_sensor", pose_json(world_from_sensor)},
+                     {"verdict", good ? std::string(hand_mode ? "good: the hand agrees with the tool within 4 cm RMS"
+                                                              : "good: corners agree within 1 cm RMS")
+                                      : std::string(hand_mode ? "poor: the hand and the tool disagree (4 cm RMS or more, or at over 20 % of the places): "
+                                                                "hold the hand on the tool, still, at more places around the workspace"
+                                                              : "poor: corners disagree (1 cm RMS or more, or over 20 % outliers): check "
+                                                                "the intrinsics, the board's mount on the tool and --board/--square")}};
+    if (!r.skipped.empty()) j["skipped"] = r.skipped;
+    if (hand_mode) {
+      j["places"] = r.places;
+      j["places_agreeing"] = r.places_agreeing;
+    }
+    if (const auto t = truth.find(r.sensor); t != truth.end()) {
+      const auto [deg, cm_err] = pose_error(world_from_sensor, t->second);
+      j["error_deg"] = deg;
+      j["error_cm"] = cm_err;
+    }
+    sensors.push_back(j);
+    skeleton::SensorPose p;
+    p.sensor_id = r.sensor;
+    p.pose = world_from_sensor;
+    p.method = hand_mode ? "robot_hand" : "robot_board";
+    p.rms_residual_m = f.rms;
+    p.max_residual_m = f.max;
+    file.sensors.push_back(p);
+  }
+  nlohmann::json out{{"method", hand_mode ? "hand at the tool" : "board on the tool"}, {"base", o.base},
+                     {"sensors", sensors}, {"failed", failed}};
+  if (!o.truth.empty()) {
+    double worst_deg = 0, worst_cm = 0;
+    for (const auto& s : sensors) {
+      if (!s.contains("error_deg")) continue;
+      worst_deg = std::max(worst_deg, s["error_deg"].get<double>());
+      worst_cm = std::max(worst_cm, s["error_cm"].get<double>());
+    }
+    out["worst_error_deg"] = worst_deg;
+    out["worst_error_cm"] = worst_cm;
+  }
+  if (!o.out.empty() && !file.sensors.empty()) {
+    write_calib(o.out, file);
+    out["written"] = o.out;
+  }
+  if (o.json) {
+    std::printf("%s\n", out.dump(2).c_str());
+  } else {
+    for (const auto& s : sensors) {
+      const auto& p = s["world_from_sensor"];
+      const std::string used = hand_mode ? std::to_string(s["holds"].get<std::size_t>()) + " holds at " +
+                                               std::to_string(s["places"].get<std::size_t>()) + " places, a hand agreeing at " +
+                                               std::to_string(s["places_agreeing"].get<std::size_t>())
+                                         : std::to_string(s["used"].get<std::size_t>()) + " of " +
+                                               std::to_string(s["views"].get<std::size_t>()) + " views used, " +
+                                               std::to_string(s["inliers"].get<std::size_t>()) + " of " +
+                                               std::to_string(s["points"].get<std::size_t>()) + " corners inliers";
+      std::printf("%s: %s, RMS %.2f cm, max %.2f cm; in the world: rotation %.2f deg, translation [%.3f, %.3f, %.3f] m%s: %s\n",
+                  s["sensor"].get<std::string>().c_str(), used.c_str(), s["rms_residual_cm"].get<double>(),
+                  s["max_residual_cm"].get<double>(), p["rotation_deg"].get<double>(), p["translation_m"][0].get<double>(),
+                  p["translation_m"][1].get<double>(), p["translation_m"][2].get<double>(),
+                  s.contains("error_deg") ? (" (off the truth by " + std::to_string(s["error_deg"].get<double>()).substr(0, 5) +
+                                             " deg, " + std::to_string(s["error_cm"].get<double>()).substr(0, 5) + " cm)").c_str()
+                                          : "",
+                  s["verdict"].get<std::string>().c_str());
+    }
+    for (const auto& f : failed) std::printf("no pose for %s\n", f.c_str());
+    if (out.contains("written")) std::printf("written to %s\n", o.out.c_str());
+  }
+  return all_good ? 0 : 1;
 }
 
 }  // namespace
@@ -972,6 +1240,40 @@ void add_calib_command(CLI::App& app, GlobalOptions&, Action& run) {
   bo->add_option("--out", b->out, "write a calibration file (YAML)");
   bo->add_flag("--json", b->json, "machine-readable result");
   bo->callback([b, &run] { run = [b] { return calib_board(*b); }; });
+
+  auto ro = std::make_shared<RobotOptions>();
+  auto* rb = cal->add_subcommand(
+      "robot",
+      "Extrinsics of the sensors in the robot's frame: a checkerboard on the tool moved through poses "
+      "(--tool-poses, one directory of views per sensor), or a person's hand held still at the tool at several "
+      "places (--hand RECORDING); RANSAC and SVD, residuals, a verdict and a calibration file in the world the "
+      "robot's base stands in (--base)");
+  rb->add_option("directories", ro->dirs, "board on the tool: one directory per sensor, named by its id, with "
+                                          "NAME_color.png + NAME_depth.png (16-bit mm) for each view NAME")
+      ->check(CLI::ExistingDirectory);
+  rb->add_option("--tool-poses", ro->tool_poses, "board on the tool: the tool's pose in the base frame for each view NAME "
+                                                 "and the board's mount on the tool (YAML, components/calib/README.md)")
+      ->check(CLI::ExistingFile);
+  rb->add_option("--hand", ro->hand_recording, "hand at the tool: an MCAP recording of skelgraph/robot/state and "
+                                               "skelgraph/skeleton/raw while a person held a hand on the tool, still, "
+                                               "at several places")
+      ->check(CLI::ExistingFile);
+  rb->add_option("--which-hand", ro->hand, "the hand held at the tool: right, left or either (default either: a sensor "
+                                           "behind the person reports the hands swapped)")
+      ->check(CLI::IsMember({"right", "left", "either"}));
+  rb->add_option("--hold", ro->hold_s, "hand at the tool: both still this long make a pair, s (default 1)")->check(kPositive);
+  rb->add_option("--inlier-cm", ro->inlier_cm, "hand at the tool: a pair agrees within this under a good pose (default 8)")->check(kPositive);
+  rb->add_option("--base", ro->base, "where the robot's base stands in the world: x,y,z (m; y up) and yaw (deg), as "
+                                     "the robot component's `base` (default 0,0,1.5,180)");
+  rb->add_option("--intrinsics", ro->intrinsics, "board: intrinsics file for every directory (default: DIR/intrinsics.yaml)")
+      ->check(CLI::ExistingFile);
+  rb->add_option("--board", ro->size, "inner corners COLSxROWS (default 9x6)");
+  rb->add_option("--square", ro->square_m, "square size, m (default 0.08)")->check(kPositive);
+  rb->add_option("--truth", ro->truth, "a calibration file with the true poses (the simulator's): report each sensor's error")
+      ->check(CLI::ExistingFile);
+  rb->add_option("--out", ro->out, "write a calibration file (YAML)");
+  rb->add_flag("--json", ro->json, "machine-readable result");
+  rb->callback([ro, &run] { run = [ro] { return calib_robot(*ro); }; });
 }
 
 }  // namespace skelgraph::cli

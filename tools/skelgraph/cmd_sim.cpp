@@ -16,6 +16,11 @@
 #include "skelgraph/calib/board.hpp"
 #include "skelgraph/calib/calib_file.hpp"
 #include "skelgraph/playback/readers.hpp"
+#include "skelgraph/recording/bag.hpp"
+#include "skelgraph/runtime/topics.hpp"
+#include "skelgraph/skeleton/skeleton_msg.hpp"
+#include "skelgraph/robot/arm.hpp"
+#include "skelgraph/robot/robot_component.hpp"
 #include "skelgraph/sim/realism.hpp"
 #include "skelgraph/sim/sim_component.hpp"
 #include "skelgraph/sim/simulation.hpp"
@@ -139,8 +144,110 @@ struct BoardsOpts {
   double square_m = 0.08, grey_noise = 2.0, depth_noise = 1.0;
   int views = 20, intrinsics_views = 15;
   std::uint64_t seed = 1;
+  std::string robot_base;  // --robot: the board on the robot's tool
+  double tool_noise_mm = 1.0, tool_noise_deg = 0.1;  // ... and the error of the tool poses it reports
   bool json = false;
 };
+
+// --robot: a checkerboard on the tool of a simulated UR5e standing at `base`,
+// moved through poses where the board faces one sensor: `views` poses per
+// sensor (any other sensor that sees a pose gets its view too), drawn at
+// random joint angles with the whole arm above the floor. DIR/<sensor>/
+// NNN_color.png + NNN_depth.png + intrinsics.yaml (the true intrinsics),
+// DIR/tool_poses.yaml (what the robot reports, and the mount), DIR/truth.yaml.
+// The arm itself is not drawn: it hides nothing of the board here.
+int write_robot_boards(const BoardsOpts& o, const sim::SimConfig& cfg, const calib::Board& board, const calib::Intrinsics& k) {
+  Eigen::Isometry3d world_from_base;
+  try {
+    world_from_base = robot::parse_base(o.robot_base);
+  } catch (const std::exception& e) {
+    throw UsageError(std::string("--robot: ") + e.what());
+  }
+  const auto arm = robot::ArmModel::ur5e();
+  calib::ToolPoses poses;
+  poses.robot = arm.name;
+  // On the flange, the printed side facing out along the tool's z, its middle 1 cm beyond the tool point.
+  const Eigen::Vector3d middle(0.5 * (board.cols - 1) * board.square_m, 0.5 * (board.rows - 1) * board.square_m, 0);
+  poses.tool_from_board.linear() = Eigen::Vector3d(1, -1, -1).asDiagonal();
+  poses.tool_from_board.translation() = Eigen::Vector3d(0, 0, 0.01) - poses.tool_from_board.linear() * middle;
+  std::vector<Eigen::Isometry3d> sensors;
+  for (const auto& s : cfg.sensors) sensors.push_back(s.world_from_sensor());
+  cv::RNG rng(o.seed);
+  std::vector<robot::Joints> chosen;
+  std::vector<Eigen::Isometry3d> boards;  // world_from_board
+  for (std::size_t si = 0; si < sensors.size(); ++si) {
+    int found = 0;
+    for (int tries = 0; found < o.views && tries < 2'000'000; ++tries) {
+      robot::Joints q;
+      q << rng.uniform(-M_PI, M_PI), rng.uniform(-M_PI, 0.0), rng.uniform(-2.6, 2.6), rng.uniform(-M_PI, M_PI),
+          rng.uniform(-M_PI, M_PI), rng.uniform(-M_PI, M_PI);
+      const auto f = robot::forward(arm, q);
+      bool above = true;
+      for (std::size_t i = 2; i < f.size(); ++i) above = above && (world_from_base * f[i].translation()).y() > 0.15;  // 0, 1: the base
+      const Eigen::Isometry3d wb = world_from_base * f[7] * poses.tool_from_board;
+      for (const auto& p : board.object_points()) above = above && (wb * p).y() > 0.15;
+      if (!above || !calib::board_in_view(sensors[si], wb, board, k)) continue;
+      chosen.push_back(q);
+      boards.push_back(wb);
+      ++found;
+    }
+    if (found < o.views) {
+      throw UsageError(cfg.sensors[si].id + ": the robot at " + o.robot_base + " shows it the board in only " +
+                       std::to_string(found) + " poses (too far from its reach?)");
+    }
+  }
+  std::size_t images = 0;
+  char name[32];
+  std::vector<std::size_t> per_sensor(sensors.size(), 0);
+  for (std::size_t si = 0; si < sensors.size(); ++si) {
+    const std::filesystem::path dir = std::filesystem::path(o.dir) / cfg.sensors[si].id;
+    std::filesystem::create_directories(dir);
+    calib::write_intrinsics_file((dir / "intrinsics.yaml").string(), k, 0.0, 0, "the simulated camera's true intrinsics");
+    for (std::size_t v = 0; v < boards.size(); ++v) {
+      if (!calib::board_in_view(sensors[si], boards[v], board, k)) continue;
+      const auto view = calib::render_board_view(board, k, calib::camera_from_board(sensors[si], boards[v]), o.grey_noise,
+                                                 o.depth_noise, o.seed * 1000003 + 1000 * si + v);
+      std::snprintf(name, sizeof name, "%03zu", v);
+      if (!cv::imwrite((dir / (std::string(name) + "_color.png")).string(), view.grey) ||
+          !cv::imwrite((dir / (std::string(name) + "_depth.png")).string(), view.depth_mm)) {
+        throw UsageError((dir / name).string() + ": cannot write the image");
+      }
+      images += 2;
+      ++per_sensor[si];
+    }
+  }
+  // What the robot reports: its true tool pose with an error (a robot's
+  // absolute accuracy is millimetres, far worse than its repeatability).
+  for (std::size_t v = 0; v < chosen.size(); ++v) {
+    std::snprintf(name, sizeof name, "%03zu", v);
+    Eigen::Isometry3d reported = robot::forward(arm, chosen[v])[7];
+    const Eigen::Vector3d axis = Eigen::Vector3d(rng.gaussian(1), rng.gaussian(1), rng.gaussian(1)).normalized();
+    reported.linear() = reported.linear() * Eigen::AngleAxisd(rng.gaussian(o.tool_noise_deg * M_PI / 180.0), axis).toRotationMatrix();
+    reported.translation() += 1e-3 * o.tool_noise_mm * Eigen::Vector3d(rng.gaussian(1), rng.gaussian(1), rng.gaussian(1));
+    poses.base_from_tool[name] = reported;
+  }
+  calib::write_tool_poses((std::filesystem::path(o.dir) / "tool_poses.yaml").string(), poses,
+                          "the simulated robot's tool poses (skelgraph sim boards --robot " + o.robot_base + ")");
+  calib::CalibFile truth;
+  truth.comment = "the simulator's true sensor poses (skelgraph sim boards --robot)";
+  for (std::size_t si = 0; si < sensors.size(); ++si) {
+    skeleton::SensorPose p;
+    p.sensor_id = cfg.sensors[si].id;
+    p.pose = sensors[si];
+    p.method = "ground_truth";
+    truth.sensors.push_back(p);
+  }
+  calib::write_calib_file((std::filesystem::path(o.dir) / "truth.yaml").string(), truth);
+  nlohmann::json views_per_sensor;
+  for (std::size_t si = 0; si < sensors.size(); ++si) views_per_sensor[cfg.sensors[si].id] = per_sensor[si];
+  if (o.json) {
+    std::printf("%s\n", nlohmann::json{{"dir", o.dir}, {"robot_poses", chosen.size()}, {"views", views_per_sensor}, {"images", images}}.dump(2).c_str());
+  } else {
+    std::printf("%s: %zu robot poses, %zu images for %zu sensors; tool poses in tool_poses.yaml, truth in truth.yaml\n",
+                o.dir.c_str(), chosen.size(), images, sensors.size());
+  }
+  return 0;
+}
 
 int write_boards(const BoardsOpts& o) {
   const auto cfg = sim_config(o.params, "sim boards");
@@ -151,6 +258,7 @@ int write_boards(const BoardsOpts& o) {
     throw UsageError(e.what());
   }
   const calib::Intrinsics k;  // Kinect-like
+  if (!o.robot_base.empty()) return write_robot_boards(o, cfg, board, k);
   std::vector<Eigen::Isometry3d> sensors;
   for (const auto& s : cfg.sensors) sensors.push_back(s.world_from_sensor());
   const Eigen::Vector3d centre(0, 1.2, 0);
@@ -214,6 +322,79 @@ int write_boards(const BoardsOpts& o) {
                              "the board's motion-capture markers in every shared view (skelgraph sim boards)");
   if (o.json) std::printf("%s\n", nlohmann::json{{"dir", o.dir}, {"sensors", sensors.size()}, {"views", shared.size()}, {"images", images}}.dump(2).c_str());
   else std::printf("%s: %zu images for %zu sensors, truth in truth.yaml\n", o.dir.c_str(), images, sensors.size());
+  return 0;
+}
+
+// A person's hand held at a robot's tool, to calibrate from (calib robot
+// --hand): a simulation whose first person's right hand the tool touches
+// wherever the hand is (the tool point `contact_cm` beyond the hand joint
+// along the forearm, where the palm closes round it); the robot's reported
+// position has an error of `tool_noise_mm` that varies smoothly over the
+// workspace (a robot's absolute accuracy). Written as a recording: the
+// sensors' skeletons (skeleton/raw), the truth, the true sensor poses
+// (calibration) and the tool (robot/state, world, at the truth's rate).
+struct HandOpts {
+  std::string out;
+  std::vector<std::string> params;
+  double contact_cm = 3.0, tool_noise_mm = 1.0;
+  bool json = false;
+};
+
+int write_hand_at_tool(const HandOpts& o) {
+  const auto cfg = sim_config(o.params, "sim hand-at-tool");
+  sim::Simulation sim(cfg);
+  recording::BagWriter bag(o.out);
+  bag.write_metadata("source", {{"source", "skelgraph sim hand-at-tool"}, {"scenario", cfg.scenario.name},
+                                {"seed", std::to_string(cfg.scenario.seed)}});
+  for (const auto& s : cfg.sensors) {
+    skeleton::SensorPose p;
+    p.sensor_id = s.id;
+    p.pose = s.world_from_sensor();
+    p.method = "ground_truth";
+    const auto m = skeleton::to_msg(p);
+    bag.write(runtime::topics::kCalibration.name, m, static_cast<std::uint64_t>(cfg.epoch_ns), static_cast<std::uint64_t>(cfg.epoch_ns));
+  }
+  cv::RNG rng(cfg.scenario.seed + 17);
+  const Eigen::Vector3d phase(rng.uniform(0.0, 2 * M_PI), rng.uniform(0.0, 2 * M_PI), rng.uniform(0.0, 2 * M_PI));
+  std::size_t states = 0, raw = 0;
+  Progress progress(!o.json);
+  for (double t = 5.0;; t += 5.0) {
+    for (auto& e : sim.advance(t)) {
+      // Logged when the world clock says (a recorder's clock); sensors stamp on their own.
+      const auto stamp = static_cast<std::uint64_t>(cfg.epoch_ns + static_cast<std::int64_t>(e.t * 1e9));
+      if (e.kind == sim::SimEvent::Kind::Raw) {
+        bag.write(runtime::topics::kSkeletonRaw.name, skeleton::to_msg(e.skeleton), stamp, stamp);
+        ++raw;
+      } else if (e.kind == sim::SimEvent::Kind::Truth) {
+        bag.write(runtime::topics::kSkeletonTruth.name, skeleton::to_msg(e.skeleton), stamp, stamp);
+        if (e.actor != sim.scenario().at(e.t).actors.front().person_id) continue;
+        const auto& hand = e.skeleton[skeleton::JointId::RightHand].position;
+        const auto& elbow = e.skeleton[skeleton::JointId::RightElbow].position;
+        const Eigen::Vector3d touch = hand + 0.01 * o.contact_cm * (hand - elbow).normalized();
+        // The robot's absolute error: smooth over the workspace (the same at the same place), sd tool_noise_mm.
+        const Eigen::Vector3d err(std::sin(7 * touch.x() + phase.x()), std::sin(7 * touch.y() + phase.y()),
+                                  std::sin(7 * touch.z() + phase.z()));
+        const Eigen::Vector3d tool = touch + 1e-3 * o.tool_noise_mm * std::sqrt(2.0) * err;
+        msg::RobotState st;
+        st.robot_id("robot1");
+        st.model("UR5e");
+        st.stamp_ns(e.skeleton.stamp_ns);
+        st.tool_position().x(tool.x());
+        st.tool_position().y(tool.y());
+        st.tool_position().z(tool.z());
+        bag.write(runtime::topics::kRobotState.name, st, stamp, stamp);
+        ++states;
+      }
+    }
+    char text[64];
+    std::snprintf(text, sizeof text, "simulated %.0f of %.0f s", std::min(t, sim.duration()), sim.duration());
+    progress(text, sim.finished());
+    if (sim.finished()) break;
+  }
+  bag.close();
+  const nlohmann::json j{{"out", o.out}, {"duration_s", sim.duration()}, {"robot_states", states}, {"raw_skeletons", raw}};
+  if (o.json) std::printf("%s\n", j.dump(2).c_str());
+  else std::printf("%s: %.0f s, %zu robot states, %zu sensor skeletons\n", o.out.c_str(), sim.duration(), states, raw);
   return 0;
 }
 
@@ -304,6 +485,16 @@ void add_sim_command(CLI::App& app, GlobalOptions&, Action& run) {
     std::vector<std::string> params;
     bool json = false;
   };
+  auto ho = std::make_shared<HandOpts>();
+  auto* h = cmd->add_subcommand("hand-at-tool", "Simulate a person's hand held at a robot's tool, written as a recording "
+                                                "(skeletons, truth, true poses, the tool's positions) for calib robot --hand");
+  h->add_option("recording", ho->out, "MCAP file to write")->required();
+  h->add_option("-p,--param", ho->params, "sim parameter as KEY=VALUE (scenario, layout, sensor_count, seed, ...)");
+  h->add_option("--contact-cm", ho->contact_cm, "the tool point beyond the hand joint, along the forearm (default 3)")->check(kNonNegative);
+  h->add_option("--tool-noise", ho->tool_noise_mm, "error of the reported tool positions, mm per axis (sd; default 1)")->check(kNonNegative);
+  h->add_flag("--json", ho->json, "machine-readable summary");
+  h->callback([ho, &run] { run = [ho] { return write_hand_at_tool(*ho); }; });
+
   auto e = std::make_shared<ExportOpts>();
   auto* x = cmd->add_subcommand("export", "Run a simulation offline and write it as generic CSV (truth, each sensor, phases)");
   x->add_option("directory", e->dir, "output directory (created)")->required();
@@ -329,6 +520,13 @@ void add_sim_command(CLI::App& app, GlobalOptions&, Action& run) {
   b->add_option("--grey-noise", bo->grey_noise, "image noise, grey levels (default 2)")->check(kNonNegative);
   b->add_option("--depth-noise", bo->depth_noise, "scale of Kinect-like depth noise (default 1)")->check(kNonNegative);
   b->add_option("--seed", bo->seed, "random seed");
+  b->add_option("--robot", bo->robot_base,
+                "X,Y,Z,YAW: the board on the tool of a simulated UR5e whose base stands there (as the robot component's "
+                "`base`), --views poses facing each sensor, and the tool poses the robot reports (for calib robot)");
+  b->add_option("--tool-noise", bo->tool_noise_mm, "with --robot: error of the reported tool positions, mm per axis (sd; default 1)")
+      ->check(kNonNegative);
+  b->add_option("--tool-noise-deg", bo->tool_noise_deg, "with --robot: error of the reported tool orientations, deg (sd; default 0.1)")
+      ->check(kNonNegative);
   b->add_flag("--json", bo->json, "machine-readable summary");
   b->callback([bo, &run] { run = [bo] { return write_boards(*bo); }; });
 }

@@ -36,8 +36,6 @@ std::vector<Vector3d> Board::object_points() const {
 
 cv::Mat camera_matrix(const Intrinsics& k) { return (cv::Mat_<double>(3, 3) << k.fx, 0, k.cx, 0, k.fy, k.cy, 0, 0, 1); }
 
-Eigen::Matrix3d sensor_from_camera() { return Eigen::Vector3d(-1, -1, 1).asDiagonal(); }
-
 namespace {
 // Mean grey level of a small patch around a point.
 double grey_at(const cv::Mat& grey, cv::Point2f p) {
@@ -230,7 +228,6 @@ std::vector<Eigen::Isometry3d> board_poses_seen_by(const std::vector<Eigen::Isom
   }
   if (towards.norm() < 1e-6) towards = Vector3d::UnitZ();
   towards.normalize();
-  const auto pts = board.object_points();
   const Vector3d middle = 0.5 * Vector3d((board.cols - 1) * board.square_m, (board.rows - 1) * board.square_m, 0);
   std::vector<Eigen::Isometry3d> out;
   for (int tries = 0; static_cast<int>(out.size()) < count && tries < 100000; ++tries) {
@@ -249,34 +246,26 @@ std::vector<Eigen::Isometry3d> board_poses_seen_by(const std::vector<Eigen::Isom
     wb.linear() = R;
     wb.translation() = c - R * middle;
     bool ok = true;
-    for (const auto& ws : world_from_sensors) {
-      const auto cb = camera_from_board(ws, wb);
-      const Vector3d front = -cb.rotation().col(2), to_camera = -(cb * middle);
-      if (front.dot(to_camera.normalized()) < std::cos(45.0 * M_PI / 180)) ok = false;
-      for (const auto& p : pts) {
-        const Vector3d q = cb * p;
-        const double u = k.fx * q.x() / q.z() + k.cx, v = k.fy * q.y() / q.z() + k.cy;
-        if (q.z() < 0.8 || q.z() > 3.0 || u < 20 || v < 20 || u > k.width - 20 || v > k.height - 20) ok = false;
-      }
-    }
+    for (const auto& ws : world_from_sensors) ok = ok && board_in_view(ws, wb, board, k);
     if (ok) out.push_back(wb);
   }
   if (static_cast<int>(out.size()) < count) throw CalibError("the sensors do not see a common place for the board");
   return out;
 }
 
-RansacResult pose_from_views(const std::vector<std::vector<Vector3d>>& a, const std::vector<std::vector<Vector3d>>& b) {
-  if (a.size() != b.size()) throw CalibError("the two sets have different numbers of views");
-  std::vector<Vector3d> pa, pb;
-  for (std::size_t v = 0; v < a.size(); ++v) {
-    if (a[v].size() != b[v].size()) throw CalibError("view " + std::to_string(v) + ": different corner counts");
-    pa.insert(pa.end(), a[v].begin(), a[v].end());
-    pb.insert(pb.end(), b[v].begin(), b[v].end());
+bool board_in_view(const Eigen::Isometry3d& world_from_sensor, const Eigen::Isometry3d& world_from_board,
+                   const Board& board, const Intrinsics& k) {
+  const Vector3d middle = 0.5 * Vector3d((board.cols - 1) * board.square_m, (board.rows - 1) * board.square_m, 0);
+  const auto cb = camera_from_board(world_from_sensor, world_from_board);
+  const Vector3d front = -cb.rotation().col(2), to_camera = -(cb * middle);
+  if (front.dot(to_camera.normalized()) < std::cos(45.0 * M_PI / 180)) return false;
+  for (const auto& p : board.object_points()) {
+    const Vector3d q = cb * p;
+    if (q.z() < 0.8 || q.z() > 3.0) return false;
+    const double u = k.fx * q.x() / q.z() + k.cx, v = k.fy * q.y() / q.z() + k.cy;
+    if (u < 20 || v < 20 || u > k.width - 20 || v > k.height - 20) return false;
   }
-  RansacOptions o;
-  o.inlier_threshold_m = 0.02;
-  o.min_inliers = 6;
-  return ransac_align(pb, pa, o);
+  return true;
 }
 
 }  // namespace skelgraph::calib

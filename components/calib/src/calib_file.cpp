@@ -45,6 +45,33 @@ YAML::Node load(const std::string& path) {
   }
 }
 
+// `translation` (m) and `rotation_xyzw` (a unit quaternion) of a mapping.
+Eigen::Isometry3d pose_at(const std::string& path, const YAML::Node& n) {
+  const auto t = numbers(path, n, "translation", 3);
+  const auto q = numbers(path, n, "rotation_xyzw", 4);
+  Eigen::Quaterniond quat(q[3], q[0], q[1], q[2]);
+  if (std::abs(quat.norm() - 1.0) > 1e-3) fail(path, n["rotation_xyzw"], "'rotation_xyzw' is not a unit quaternion (norm " + std::to_string(quat.norm()) + ")");
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = quat.normalized().toRotationMatrix();
+  pose.translation() = Eigen::Vector3d(t[0], t[1], t[2]);
+  return pose;
+}
+
+void emit_pose(YAML::Emitter& e, const Eigen::Isometry3d& pose) {
+  const Eigen::Quaterniond q(pose.rotation());
+  const Eigen::Vector3d t = pose.translation();
+  e << YAML::Key << "translation" << YAML::Value << YAML::Flow << std::vector<double>{t.x(), t.y(), t.z()};
+  e << YAML::Key << "rotation_xyzw" << YAML::Value << YAML::Flow << std::vector<double>{q.x(), q.y(), q.z(), q.w()};
+}
+
+// The emitted document, after a first-line comment.
+void save(const std::string& path, const YAML::Emitter& e, const std::string& comment) {
+  std::ofstream out(path);
+  if (!comment.empty()) out << "# " << comment << "\n";
+  out << e.c_str() << "\n";
+  if (!out.flush()) throw CalibFileError(path + ": cannot write the file");
+}
+
 }  // namespace
 
 CalibFile read_calib_file(const std::string& path) {
@@ -62,13 +89,7 @@ CalibFile read_calib_file(const std::string& path) {
     skeleton::SensorPose p;
     p.sensor_id = s["id"].as<std::string>();
     p.frame_id = f.frame_id;
-    const auto t = numbers(path, s, "translation", 3);
-    const auto q = numbers(path, s, "rotation_xyzw", 4);
-    Eigen::Quaterniond quat(q[3], q[0], q[1], q[2]);
-    if (std::abs(quat.norm() - 1.0) > 1e-3) fail(path, s["rotation_xyzw"], "'rotation_xyzw' is not a unit quaternion (norm " + std::to_string(quat.norm()) + ")");
-    p.pose = Eigen::Isometry3d::Identity();
-    p.pose.linear() = quat.normalized().toRotationMatrix();
-    p.pose.translation() = Eigen::Vector3d(t[0], t[1], t[2]);
+    p.pose = pose_at(path, s);
     p.method = s["method"] ? s["method"].as<std::string>() : "manual";
     p.rms_residual_m = s["rms_residual_m"] ? s["rms_residual_m"].as<double>() : 0.0;
     p.max_residual_m = s["max_residual_m"] ? s["max_residual_m"].as<double>() : 0.0;
@@ -86,20 +107,14 @@ void write_calib_file(const std::string& path, const CalibFile& f) {
   e << YAML::BeginMap << YAML::Key << "version" << YAML::Value << 1 << YAML::Key << "frame_id" << YAML::Value
     << f.frame_id << YAML::Key << "sensors" << YAML::Value << YAML::BeginSeq;
   for (const auto& p : f.sensors) {
-    const Eigen::Quaterniond q(p.pose.rotation());
-    const Eigen::Vector3d t = p.pose.translation();
     e << YAML::BeginMap << YAML::Key << "id" << YAML::Value << p.sensor_id;
-    e << YAML::Key << "translation" << YAML::Value << YAML::Flow << std::vector<double>{t.x(), t.y(), t.z()};
-    e << YAML::Key << "rotation_xyzw" << YAML::Value << YAML::Flow << std::vector<double>{q.x(), q.y(), q.z(), q.w()};
+    emit_pose(e, p.pose);
     e << YAML::Key << "method" << YAML::Value << p.method;
     e << YAML::Key << "rms_residual_m" << YAML::Value << p.rms_residual_m;
     e << YAML::Key << "max_residual_m" << YAML::Value << p.max_residual_m << YAML::EndMap;
   }
   e << YAML::EndSeq << YAML::EndMap;
-  std::ofstream out(path);
-  if (!f.comment.empty()) out << "# " << f.comment << "\n";
-  out << e.c_str() << "\n";
-  if (!out.flush()) throw CalibFileError(path + ": cannot write the file");
+  save(path, e, f.comment);
 }
 
 namespace {
@@ -161,10 +176,7 @@ void write_board_markers(const std::string& path, const BoardMarkers& m, const s
     e << YAML::EndMap;
   }
   e << YAML::EndSeq << YAML::EndMap;
-  std::ofstream out(path);
-  if (!comment.empty()) out << "# " << comment << "\n";
-  out << e.c_str() << "\n";
-  if (!out.flush()) throw CalibFileError(path + ": cannot write the file");
+  save(path, e, comment);
 }
 
 Intrinsics read_intrinsics_file(const std::string& path) {
@@ -207,10 +219,47 @@ void write_intrinsics_file(const std::string& path, const Intrinsics& k, double 
   e << YAML::Key << "distortion" << YAML::Value << YAML::Flow << k.distortion;
   e << YAML::Key << "rms_reprojection_px" << YAML::Value << rms_reprojection_px;
   e << YAML::Key << "views" << YAML::Value << views << YAML::EndMap;
-  std::ofstream out(path);
-  if (!comment.empty()) out << "# " << comment << "\n";
-  out << e.c_str() << "\n";
-  if (!out.flush()) throw CalibFileError(path + ": cannot write the file");
+  save(path, e, comment);
+}
+
+ToolPoses read_tool_poses(const std::string& path) {
+  const YAML::Node root = load(path);
+  if (!root.IsMap() || !root["version"] || root["version"].as<std::string>("") != "1") {
+    fail(path, root, "expected a tool poses file with 'version: 1'");
+  }
+  ToolPoses t;
+  t.robot = root["robot"] ? root["robot"].as<std::string>() : "";
+  if (!root["board_on_tool"] || !root["board_on_tool"].IsMap()) {
+    fail(path, root, "expected 'board_on_tool': {translation, rotation_xyzw}, the board's pose in the tool frame");
+  }
+  t.tool_from_board = pose_at(path, root["board_on_tool"]);
+  const auto views = root["views"];
+  if (!views || !views.IsSequence() || views.size() == 0) {
+    fail(path, views ? views : root, "expected 'views': a list of {name, translation, rotation_xyzw}, the tool in the base frame");
+  }
+  for (const auto& v : views) {
+    if (!v.IsMap() || !v["name"]) fail(path, v, "each view needs a 'name'");
+    const auto name = v["name"].as<std::string>();
+    if (t.base_from_tool.count(name)) fail(path, v["name"], "view '" + name + "' is listed twice");
+    t.base_from_tool[name] = pose_at(path, v);
+  }
+  return t;
+}
+
+void write_tool_poses(const std::string& path, const ToolPoses& t, const std::string& comment) {
+  YAML::Emitter e;
+  e.SetDoublePrecision(9);
+  e << YAML::BeginMap << YAML::Key << "version" << YAML::Value << 1 << YAML::Key << "robot" << YAML::Value << t.robot;
+  e << YAML::Key << "board_on_tool" << YAML::Value << YAML::BeginMap;
+  emit_pose(e, t.tool_from_board);
+  e << YAML::EndMap << YAML::Key << "views" << YAML::Value << YAML::BeginSeq;
+  for (const auto& [name, pose] : t.base_from_tool) {
+    e << YAML::BeginMap << YAML::Key << "name" << YAML::Value << YAML::DoubleQuoted << name;
+    emit_pose(e, pose);
+    e << YAML::EndMap;
+  }
+  e << YAML::EndSeq << YAML::EndMap;
+  save(path, e, comment);
 }
 
 }  // namespace skelgraph::calib

@@ -183,4 +183,20 @@ double rotation_angle_deg(const Matrix3d& R) {
   return std::acos(c) * 180.0 / M_PI;
 }
 
+Eigen::Matrix3d sensor_from_camera() { return Eigen::Vector3d(-1, -1, 1).asDiagonal(); }
+
+RansacResult pose_from_views(const std::vector<std::vector<Eigen::Vector3d>>& a, const std::vector<std::vector<Eigen::Vector3d>>& b) {
+  if (a.size() != b.size()) throw CalibError("the two sets have different numbers of views");
+  std::vector<Eigen::Vector3d> pa, pb;
+  for (std::size_t v = 0; v < a.size(); ++v) {
+    if (a[v].size() != b[v].size()) throw CalibError("view " + std::to_string(v) + ": different corner counts");
+    pa.insert(pa.end(), a[v].begin(), a[v].end());
+    pb.insert(pb.end(), b[v].begin(), b[v].end());
+  }
+  RansacOptions o;
+  o.inlier_threshold_m = 0.02;
+  o.min_inliers = 6;
+  return ransac_align(pb, pa, o);
+}
+
 }  // namespace skelgraph::calib

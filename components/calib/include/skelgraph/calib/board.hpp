@@ -31,8 +31,6 @@ struct Board {
 
 cv::Mat camera_matrix(const Intrinsics& k);
 
-Eigen::Matrix3d sensor_from_camera();  // diag(-1, -1, 1)
-
 // The board's inner corners in an 8-bit grey image, refined to sub-pixel and
 // put in one order whichever way the board is turned (the square between
 // the first four corners is the dark one); empty if the board is not found.
@@ -74,13 +72,15 @@ std::vector<Eigen::Isometry3d> board_poses_seen_by(const std::vector<Eigen::Isom
                                                    const Board& board, const Intrinsics& k, int count,
                                                    const Eigen::Vector3d& centre, std::uint64_t seed);
 
+// Whether a sensor (world_from_sensor) sees the whole board
+// (world_from_board) well enough to calibrate from: every corner in the
+// image 20 px from its edge, 0.8-3 m away, the printed side facing it within
+// 45 degrees. Nothing between them is modelled.
+bool board_in_view(const Eigen::Isometry3d& world_from_sensor, const Eigen::Isometry3d& world_from_board,
+                   const Board& board, const Intrinsics& k);
+
 // camera_from_board for a sensor at world_from_sensor.
 Eigen::Isometry3d camera_from_board(const Eigen::Isometry3d& world_from_sensor, const Eigen::Isometry3d& world_from_board);
 
-// One pose from corresponding corner sets of several views (e.g. the same
-// boards lifted in two cameras, or lifted in a camera and known in the
-// world): all corners pooled, RANSAC (2 cm) then SVD on the inliers. Maps b's frame into a's.
-RansacResult pose_from_views(const std::vector<std::vector<Eigen::Vector3d>>& a,
-                             const std::vector<std::vector<Eigen::Vector3d>>& b);
 
 }  // namespace skelgraph::calib

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "skelgraph/calib/intrinsics.hpp"
+#include "skelgraph/calib/robot_calib.hpp"
 #include "skelgraph/skeleton/skeleton_msg.hpp"
 
 namespace skelgraph::calib {
@@ -64,5 +65,17 @@ void write_board_markers(const std::string& path, const BoardMarkers& m, const s
 Intrinsics read_intrinsics_file(const std::string& path);
 void write_intrinsics_file(const std::string& path, const Intrinsics& k, double rms_reprojection_px, std::size_t views,
                            const std::string& comment);
+
+// Tool poses files (YAML), for `skelgraph calib robot` with a board on the
+// tool: how the board sits on the tool (its pose in the tool frame; board
+// frame as above) and, per view NAME, the tool's pose in the robot's base
+// frame as the robot reported it when the view was taken.
+//   version: 1
+//   robot: UR5e
+//   board_on_tool: {translation: [0, 0, 0.01], rotation_xyzw: [1, 0, 0, 0]}
+//   views:
+//     - {name: "000", translation: [x, y, z], rotation_xyzw: [x, y, z, w]}
+ToolPoses read_tool_poses(const std::string& path);
+void write_tool_poses(const std::string& path, const ToolPoses& t, const std::string& comment);
 
 }  // namespace skelgraph::calib

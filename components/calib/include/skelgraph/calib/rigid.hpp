@@ -68,6 +68,16 @@ struct RansacResult {
 RansacResult ransac_align(const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b,
                           const RansacOptions& options = {});
 
+// One pose from corresponding corner sets of several views (e.g. the same
+// boards lifted in two cameras, or lifted in a camera and known in the
+// world): all corners pooled, RANSAC (2 cm) then SVD on the inliers. Maps b's frame into a's.
+RansacResult pose_from_views(const std::vector<std::vector<Eigen::Vector3d>>& a,
+                             const std::vector<std::vector<Eigen::Vector3d>>& b);
+
+// OpenCV camera frame (x right, y down, z forward) to skelgraph's sensor
+// frames (the skeleton trackers': x left, y up, z forward): diag(-1, -1, 1).
+Eigen::Matrix3d sensor_from_camera();
+
 // Angle of a rotation, degrees.
 double rotation_angle_deg(const Eigen::Matrix3d& R);
 
