@@ -32,7 +32,11 @@ states = {x["state"] for x in rows}
 assert {"PROTECTIVE_STOP"} < states, states
 near = [x for x in rows if x["state"] == "PROTECTIVE_STOP" and x["separation_m"] is not None and x["separation_m"] >= 0]
 assert all(x["protective_m"] is not None for x in near), [x for x in near if x["protective_m"] is None][:3]
-assert near and all(x["separation_m"] < x["protective_m"] + 0.3 + 1e-6 or "no useful speed" in x["reason"] or "holding the stop" in x["reason"] for x in near), near[:3]
+# Every stop has its reason: too close, or a fail-safe one (a busy machine delays frames: data too old, a
+# sensor lost, a person not placed), and the hold after either.
+justified = ("no useful speed", "holding the stop", "is lost and no other covers it", "ms old (limit", "fusion cannot place")
+unjustified = [x for x in near if not (x["separation_m"] < x["protective_m"] + 0.3 + 1e-6 or any(j in x["reason"] for j in justified))]
+assert near and not unjustified, unjustified[:3]
 assert all(x["body_part"] and x["robot_part"] for x in near), near[:3]
 print("ok: robot cell: %s; reaction p50 %.0f ms; %d protective stops" % (by, r["p50"], robot["protective_stops"]))
 PY
