@@ -110,11 +110,10 @@ void write_file(const std::filesystem::path& path, const playback::Recording& re
   if (!out.flush()) throw std::runtime_error("error writing " + path.string());
 }
 
-// The simulated sensors' true poses as a calibration file.
-int write_poses(const std::vector<std::string>& assignments, const std::string& out, bool json) {
-  const auto cfg = sim_config(assignments, "sim poses");
+// The simulated sensors' true poses, as a calibration file says them.
+calib::CalibFile true_poses(const sim::SimConfig& cfg, const std::string& comment) {
   calib::CalibFile f;
-  f.comment = "the simulator's true sensor poses (skelgraph sim poses)";
+  f.comment = comment;
   for (const auto& s : cfg.sensors) {
     skeleton::SensorPose p;
     p.sensor_id = s.id;
@@ -122,6 +121,13 @@ int write_poses(const std::vector<std::string>& assignments, const std::string& 
     p.method = "ground_truth";
     f.sensors.push_back(p);
   }
+  return f;
+}
+
+// The simulated sensors' true poses as a calibration file.
+int write_poses(const std::vector<std::string>& assignments, const std::string& out, bool json) {
+  const auto cfg = sim_config(assignments, "sim poses");
+  const auto f = true_poses(cfg, "the simulator's true sensor poses (skelgraph sim poses)");
   try {
     calib::write_calib_file(out, f);
   } catch (const calib::CalibFileError& e) {
@@ -228,16 +234,8 @@ int write_robot_boards(const BoardsOpts& o, const sim::SimConfig& cfg, const cal
   }
   calib::write_tool_poses((std::filesystem::path(o.dir) / "tool_poses.yaml").string(), poses,
                           "the simulated robot's tool poses (skelgraph sim boards --robot " + o.robot_base + ")");
-  calib::CalibFile truth;
-  truth.comment = "the simulator's true sensor poses (skelgraph sim boards --robot)";
-  for (std::size_t si = 0; si < sensors.size(); ++si) {
-    skeleton::SensorPose p;
-    p.sensor_id = cfg.sensors[si].id;
-    p.pose = sensors[si];
-    p.method = "ground_truth";
-    truth.sensors.push_back(p);
-  }
-  calib::write_calib_file((std::filesystem::path(o.dir) / "truth.yaml").string(), truth);
+  calib::write_calib_file((std::filesystem::path(o.dir) / "truth.yaml").string(),
+                          true_poses(cfg, "the simulator's true sensor poses (skelgraph sim boards --robot)"));
   nlohmann::json views_per_sensor;
   for (std::size_t si = 0; si < sensors.size(); ++si) views_per_sensor[cfg.sensors[si].id] = per_sensor[si];
   if (o.json) {
@@ -294,16 +292,8 @@ int write_boards(const BoardsOpts& o) {
     calib::write_intrinsics_file((dir / "intrinsics_truth.yaml").string(), k, 0.0, 0, "the simulated camera's true intrinsics");
     if (!o.json) std::fprintf(stderr, "%s: %zu shared views, %zu intrinsics views\n", cfg.sensors[si].id.c_str(), shared.size(), own.size());
   }
-  calib::CalibFile truth;
-  truth.comment = "the simulator's true sensor poses (skelgraph sim boards)";
-  for (std::size_t si = 0; si < sensors.size(); ++si) {
-    skeleton::SensorPose p;
-    p.sensor_id = cfg.sensors[si].id;
-    p.pose = sensors[si];
-    p.method = "ground_truth";
-    truth.sensors.push_back(p);
-  }
-  calib::write_calib_file((std::filesystem::path(o.dir) / "truth.yaml").string(), truth);
+  calib::write_calib_file((std::filesystem::path(o.dir) / "truth.yaml").string(),
+                          true_poses(cfg, "the simulator's true sensor poses (skelgraph sim boards)"));
   // Motion-capture markers on the board (four round its edge, one on a
   // stalk), seen in the world with 0.5 mm of noise.
   calib::BoardMarkers markers;
@@ -346,13 +336,9 @@ int write_hand_at_tool(const HandOpts& o) {
   recording::BagWriter bag(o.out);
   bag.write_metadata("source", {{"source", "skelgraph sim hand-at-tool"}, {"scenario", cfg.scenario.name},
                                 {"seed", std::to_string(cfg.scenario.seed)}});
-  for (const auto& s : cfg.sensors) {
-    skeleton::SensorPose p;
-    p.sensor_id = s.id;
-    p.pose = s.world_from_sensor();
-    p.method = "ground_truth";
-    const auto m = skeleton::to_msg(p);
-    bag.write(runtime::topics::kCalibration.name, m, static_cast<std::uint64_t>(cfg.epoch_ns), static_cast<std::uint64_t>(cfg.epoch_ns));
+  for (const auto& p : true_poses(cfg, "").sensors) {
+    bag.write(runtime::topics::kCalibration.name, skeleton::to_msg(p), static_cast<std::uint64_t>(cfg.epoch_ns),
+              static_cast<std::uint64_t>(cfg.epoch_ns));
   }
   cv::RNG rng(cfg.scenario.seed + 17);
   const Eigen::Vector3d phase(rng.uniform(0.0, 2 * M_PI), rng.uniform(0.0, 2 * M_PI), rng.uniform(0.0, 2 * M_PI));
