@@ -59,11 +59,26 @@ ok "live: gesture states read over DDS, 'holding' during each pointing event"
 
 "$S" gesture sim --train-sessions 4 --test-sessions 2 --json >"$WORK/sim.json" 2>/dev/null || fail "gesture sim"
 json_check "$WORK/sim.json" 'd["spotting"]["truth"] == 12 and d["spotting"]["recall"] >= 0.8 and d["spotting"]["median_target_error_m"] < 0.4'
-ok "offline: held-out simulated sessions scored"
+# False alarms: a session of each scenario where nobody gestures, every event counted against its hours.
+python3 - "$WORK/sim.json" <<'PY' || fail "false alarms: $(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["false_alarms"])' "$WORK/sim.json")"
+import json, sys
+q = json.load(open(sys.argv[1]))["false_alarms"]
+names = [s["scenario"] for s in q["scenarios"]]
+assert names == ["walk", "360", "hide", "box", "occ", "sit", "arms", "work"], names
+assert all(s["seconds"] > 10 for s in q["scenarios"]), q["scenarios"]
+assert abs(q["hours"] - sum(s["seconds"] for s in q["scenarios"]) / 3600) < 1e-9, q
+for label, n in q["events"].items():
+    assert n == sum(s["events"].get(label, 0) for s in q["scenarios"]), (label, q)
+    assert abs(q["per_hour"][label] - n / q["hours"]) < 1e-6, (label, q)
+assert "point" in q["per_hour"], q
+print("false pointing events per hour: %.1f over %.2f h (%s)" % (q["per_hour"]["point"], q["hours"],
+      ", ".join("%s %d" % (s["scenario"], s["events"].get("point", 0)) for s in q["scenarios"])))
+PY
+ok "offline: held-out simulated sessions scored, false alarms counted in eight scenarios without gestures"
 
 # The same sessions without the trackers' random errors: the targets land
 # within a few centimetres (what is left at noise 1 is the trackers' noise).
-"$S" gesture sim --train-sessions 4 --test-sessions 2 --test-noise-scale 0 --json >"$WORK/sim0.json" 2>/dev/null || fail "gesture sim --test-noise-scale 0"
+"$S" gesture sim --train-sessions 4 --test-sessions 2 --test-noise-scale 0 --quiet-sessions 0 --json >"$WORK/sim0.json" 2>/dev/null || fail "gesture sim --test-noise-scale 0"
 python3 - "$WORK/sim.json" "$WORK/sim0.json" <<'PY' || fail "noise-free test sessions"
 import json, sys
 a, b = (json.load(open(f)) for f in sys.argv[1:])

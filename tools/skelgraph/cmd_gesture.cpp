@@ -19,6 +19,7 @@
 #include "skelgraph/gesture/dataset.hpp"
 #include "skelgraph/gesture/sim_sessions.hpp"
 #include "skelgraph/gesture/spotter.hpp"
+#include "skelgraph/sim/scenario.hpp"
 
 namespace skelgraph::cli {
 
@@ -58,6 +59,8 @@ struct GestureOptions {
   // sim
   int train_sessions = 8, test_sessions = 4;
   double test_noise_scale = 1.0;  // gesture sim: the test sessions' tracker noise
+  std::vector<std::string> quiet_scenarios = gesture::quiet_scenarios();  // gesture sim: where nobody gestures
+  int quiet_sessions = 1;                                                  // ... sessions of each
   SpotterOptions spot;
   double gap = 0.0;
   double rest = 0.0;
@@ -430,6 +433,16 @@ int gesture_sim(const GestureOptions& o) {
   const auto test = held_out_sessions(o.test_sessions, o.seed, [&](int d, int t) { progress("simulating and fusing test sessions", d, t); },
                                       o.test_noise_scale);
   const auto spotted = spot_sessions(model, test, o.spot);
+  const auto quiet = spot_quiet(model,
+                                quiet_sessions(o.quiet_scenarios, o.quiet_sessions, o.seed,
+                                               [&](int d, int t) { progress("simulating and fusing sessions without gestures", d, t); },
+                                               o.test_noise_scale),
+                                o.spot);
+  nlohmann::json quiet_json{{"hours", quiet.hours}, {"events", quiet.events}, {"per_hour", nlohmann::json::object()},
+                            {"scenarios", nlohmann::json::array()}};
+  for (const auto& [label, n] : quiet.events) quiet_json["per_hour"][label] = quiet.per_hour(label);
+  quiet_json["per_hour"]["point"] = quiet.per_hour("point");
+  for (const auto& s : quiet.scenarios) quiet_json["scenarios"].push_back({{"scenario", s.name}, {"seconds", s.seconds}, {"events", s.events}});
   std::vector<SpottedEvent> events;
   std::vector<SpottingReport> reports;
   nlohmann::json per = nlohmann::json::array();
@@ -483,6 +496,7 @@ int gesture_sim(const GestureOptions& o) {
                                           {"hand", {model.pointing_correction().hand.x(), model.pointing_correction().hand.y(),
                                                     model.pointing_correction().hand.z()}}}},
                                         {"spotting", to_json(r)},
+                                        {"false_alarms", quiet_json},
                                         {"spotted_within_15_cm", within(r.target_error_m)},
                                         {"whole_hold_reference", whole_json},
                                         {"sessions", per},
@@ -501,6 +515,13 @@ int gesture_sim(const GestureOptions& o) {
               100 * pc.hand.z(), pc.elevation, pc.azimuth_out);
   std::printf("latency: median %.0f ms after the hold began, %.0f ms from the end of the gesture (negative: before)\n",
               1e3 * r.median_latency_hold_s, 1e3 * r.median_latency_s);
+  std::string by;
+  for (const auto& s : quiet.scenarios) {
+    const auto it = s.events.find("point");
+    by += (by.empty() ? "" : ", ") + s.name + " " + std::to_string(it == s.events.end() ? 0 : it->second);
+  }
+  std::printf("false pointing events while nobody points: %.1f per hour (%d in %.0f s of %s)\n", quiet.per_hour("point"),
+              quiet.events.count("point") ? quiet.events.at("point") : 0, quiet.hours * 3600.0, by.c_str());
   if (!r.target_error_m.empty())
     std::printf("target on the floor: median error %.1f cm, largest %.1f cm, %td of %zu within 15 cm; ray direction: median %.1f deg off\n",
                 100 * r.median_target_error_m, 100 * r.max_target_error_m, within(r.target_error_m), r.target_error_m.size(),
@@ -627,6 +648,11 @@ void add_gesture_command(CLI::App& app, GlobalOptions&, Action& run) {
                  "scale of the trackers' random errors in the test sessions (default 1; 0 leaves the skeleton convention's "
                  "offsets, the lag and the geometry: how far the targets are off without the tracker's noise)")
       ->check(CLI::Range(0.0, 10.0));
+  sm->add_option("--quiet-scenarios", o->quiet_scenarios,
+                 "simulator scenarios where nobody gestures, spotted for false alarms (default walk,360,hide,box,occ,sit,arms,work)")
+      ->delimiter(',')
+      ->check(CLI::IsMember(sim::scenario_names()));
+  sm->add_option("--quiet-sessions", o->quiet_sessions, "sessions of each of them (default 1; 0: none)")->check(CLI::Range(0, 200));
   sm->add_option("--out", o->out, "write the trained classifier (JSON), e.g. for the gesture component");
   add_spotter_options(sm, *o);
   sm->add_option("--window", o->spot.window, "s over which hand speed is measured (default 0.25)")->check(CLI::Range(0.03, 2.0));

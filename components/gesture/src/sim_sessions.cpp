@@ -12,9 +12,9 @@ namespace skelgraph::gesture {
 using Eigen::Vector3d;
 using skeleton::JointId;
 
-SimSession simulate_session(std::uint64_t seed, const Surface& floor, double noise_scale) {
+SimSession simulate_session(std::uint64_t seed, const Surface& floor, double noise_scale, const std::string& scenario) {
   sim::SimConfig cfg;
-  cfg.scenario.name = "point";
+  cfg.scenario.name = scenario;
   cfg.scenario.seed = seed;
   cfg.noise_scale = noise_scale;
   sim::Simulation simulation(cfg);
@@ -41,11 +41,13 @@ SimSession simulate_session(std::uint64_t seed, const Surface& floor, double noi
   }
   std::stable_sort(events.begin(), events.end(), [](const auto& a, const auto& b) { return a.t_ns < b.t_ns; });
   SimSession out;
+  out.scenario = scenario;
   eval::OfflineOptions eo;
   eo.methods = {fusion::Method::Kalman};
   eo.singles = false;
   eval::evaluate(poses, events, eo, [&](fusion::Method, const skeleton::Skeleton& s) { out.fused.push_back(s); });
 
+  if (scenario != "point") return out;  // nobody gestures
   // Runs of non-rest phases are gestures.
   for (std::size_t i = 0; i < truth.size();) {
     if (truth[i].phase == "rest") {
@@ -217,6 +219,49 @@ std::vector<SimSession> held_out_sessions(int sessions, std::uint64_t seed, cons
     if (progress) progress(i + 1, sessions);
   }
   return out;
+}
+
+const std::vector<std::string>& quiet_scenarios() {
+  static const std::vector<std::string> names{"walk", "360", "hide", "box", "occ", "sit", "arms", "work"};
+  return names;
+}
+
+std::vector<SimSession> quiet_sessions(const std::vector<std::string>& scenarios, int per_scenario, std::uint64_t seed,
+                                       const std::function<void(int, int)>& progress, double noise_scale) {
+  std::vector<SimSession> out;
+  const int total = per_scenario * static_cast<int>(scenarios.size());
+  for (const auto& name : scenarios) {
+    for (int i = 0; i < per_scenario; ++i) {
+      out.push_back(simulate_session((seed + 1) * 1000 + 700 + static_cast<std::uint64_t>(i), {}, noise_scale, name));
+      if (progress) progress(static_cast<int>(out.size()), total);
+    }
+  }
+  return out;
+}
+
+double QuietReport::per_hour(const std::string& label) const {
+  const auto it = events.find(label);
+  return hours > 0 ? (it == events.end() ? 0 : it->second) / hours : 0.0;
+}
+
+QuietReport spot_quiet(const Classifier& model, const std::vector<SimSession>& sessions, const SpotterOptions& options) {
+  QuietReport r;
+  const auto spotted = spot_sessions(model, sessions, options);
+  for (std::size_t n = 0; n < sessions.size(); ++n) {
+    const auto& s = sessions[n];
+    auto it = std::find_if(r.scenarios.begin(), r.scenarios.end(), [&](const auto& x) { return x.name == s.scenario; });
+    if (it == r.scenarios.end()) it = r.scenarios.insert(r.scenarios.end(), QuietReport::Scenario{s.scenario, 0, {}});
+    if (!s.fused.empty()) {
+      const double seconds = static_cast<double>(s.fused.back().stamp_ns - s.fused.front().stamp_ns) * 1e-9;
+      it->seconds += seconds;
+      r.hours += seconds / 3600.0;
+    }
+    for (const auto& e : spotted[n].events) {
+      ++it->events[e.label];
+      ++r.events[e.label];
+    }
+  }
+  return r;
 }
 
 std::vector<SessionSpotting> spot_sessions(const Classifier& model, const std::vector<SimSession>& sessions,

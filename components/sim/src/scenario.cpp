@@ -202,6 +202,72 @@ void script_arms(Builder& b) {
   }
 }
 
+// Ordinary work at a bench beside a robot, 60 s, with arm motions close to
+// pointing that are not pointing: reaching to the bench, picking up and
+// placing parts, carrying one round (turning with the arms bent), turning to
+// the robot and back, scratching the head, adjusting glasses, and taking a
+// tool from a shelf at the side (the arm straight out and held: the pose of
+// pointing, at shoulder height). Nobody gestures. Phases name the motion.
+void script_work_cell(Builder& b) {
+  const BodyPose rest = b.cur;
+  const double end = b.t + 60.0;
+  while (b.t < end - 1.0) {
+    const double u = b.rng.uniform();
+    const bool right = b.rng.chance(0.6);
+    BodyPose p = rest;
+    ArmPose& arm = right ? p.right_arm : p.left_arm;
+    std::string phase;
+    double hold = 0.0;
+    if (u < 0.2) {  // reach to the bench in front, elbow a little bent
+      arm = {deg(b.rng.uniform(55.0, 85.0)), deg(b.rng.uniform(-15.0, 25.0)), b.rng.uniform(0.2, 0.7), 0.0};
+      p.trunk_pitch = b.rng.uniform(0.1, 0.3);
+      phase = "reach_bench", hold = b.rng.uniform(0.5, 1.5);
+    } else if (u < 0.35) {  // pick a part up low, then place it to the side
+      p.trunk_pitch = b.rng.uniform(0.3, 0.6);
+      arm = {deg(b.rng.uniform(30.0, 50.0)), deg(b.rng.uniform(-10.0, 20.0)), b.rng.uniform(0.1, 0.4), 0.0};
+      b.to(p, b.rng.uniform(0.6, 1.0), "pick");
+      b.hold(b.rng.uniform(0.3, 0.8), "pick");
+      p.trunk_pitch = b.rng.uniform(0.1, 0.3);
+      arm = {deg(b.rng.uniform(50.0, 75.0)), deg(b.rng.uniform(30.0, 70.0)), b.rng.uniform(0.3, 0.8), 0.0};
+      phase = "place", hold = b.rng.uniform(0.3, 0.8);
+    } else if (u < 0.47) {  // carry a part round: both forearms up, turning
+      const ArmPose carry{deg(b.rng.uniform(20.0, 35.0)), 0.0, b.rng.uniform(1.2, 1.6), 0.0};
+      p = with_arms(p, carry, carry);
+      b.to(p, 0.7, "carry");
+      p.heading += deg(b.rng.uniform(60.0, 120.0)) * (b.rng.chance(0.5) ? 1 : -1);
+      b.to(p, b.rng.uniform(1.0, 1.8), "carry", true);
+      b.hold(b.rng.uniform(0.3, 0.8), "carry");
+      p = with_arms(p, arm_rest(), arm_rest());
+      b.to(p, 0.6, "carry");
+      p.heading = rest.heading;
+      b.to(p, b.rng.uniform(1.0, 1.6), "turn_back", true);
+      continue;
+    } else if (u < 0.57) {  // turn to the robot, watch it, turn back
+      p.heading += deg(b.rng.uniform(40.0, 80.0)) * (b.rng.chance(0.5) ? 1 : -1);
+      b.to(p, b.rng.uniform(0.8, 1.2), "turn_to_robot", true);
+      b.hold(b.rng.uniform(1.0, 2.5), "watch_robot");
+      b.to(rest, b.rng.uniform(0.8, 1.2), "turn_back", true);
+      continue;
+    } else if (u < 0.67) {  // scratch the head
+      arm = {deg(b.rng.uniform(130.0, 155.0)), deg(b.rng.uniform(40.0, 70.0)), b.rng.uniform(2.0, 2.4), 0.3};
+      phase = "scratch_head", hold = b.rng.uniform(0.8, 2.0);
+    } else if (u < 0.77) {  // adjust glasses
+      arm = {deg(b.rng.uniform(45.0, 65.0)), deg(b.rng.uniform(-10.0, 10.0)), b.rng.uniform(2.3, 2.6), 0.6};
+      phase = "glasses", hold = b.rng.uniform(0.4, 1.0);
+    } else if (u < 0.87) {  // a tool from the shelf at the side: the arm straight out, held while the hand finds it
+      arm = {deg(b.rng.uniform(80.0, 110.0)), deg(b.rng.uniform(45.0, 95.0)), b.rng.uniform(0.0, 0.25), 0.0};
+      phase = "shelf", hold = b.rng.uniform(0.5, 1.2);
+    } else {
+      b.hold(b.rng.uniform(1.0, 3.0), "rest");
+      continue;
+    }
+    b.to(p, b.rng.uniform(0.5, 0.9), phase);
+    b.hold(hold, phase);
+    b.to(rest, b.rng.uniform(0.5, 0.9), "rest");
+  }
+  b.hold(std::max(0.2, end - b.t), "rest");
+}
+
 // Pointing at the floor of the cell (the arm straight, 35-65 degrees from
 // hanging down, so the ray meets the floor 1-3 m away), with either arm,
 // between waves and overhead stretches that are not pointing. Phases:
@@ -336,7 +402,7 @@ BodyPose interpolate(const BodyPose& a, const BodyPose& b, double u) {
 
 const std::vector<std::string>& scenario_names() {
   static const std::vector<std::string> names{"walk", "360",   "hide",  "box",  "occ",  "sit",
-                                              "arms", "point", "shift", "tour", "robot"};
+                                              "arms", "point", "shift", "tour", "robot", "work"};
   return names;
 }
 
@@ -381,6 +447,8 @@ Scenario::Scenario(const ScenarioOptions& options) : opt_(options) {
       script_arms(b);
     } else if (n == "robot") {
       script_robot(b);
+    } else if (n == "work") {
+      script_work_cell(b);
     } else {
       script_point(b, rng);
     }

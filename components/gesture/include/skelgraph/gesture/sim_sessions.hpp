@@ -7,6 +7,8 @@
 
 #include <cstdint>
 #include <functional>
+#include <map>
+#include <string>
 #include <vector>
 
 #include "skelgraph/gesture/classifier.hpp"
@@ -16,7 +18,8 @@
 namespace skelgraph::gesture {
 
 struct SimSession {
-  std::vector<skeleton::Skeleton> fused;  // person 1's fused skeletons (world frame), in time order
+  std::string scenario = "point";
+  std::vector<skeleton::Skeleton> fused;  // the fused skeletons (world frame), in time order
   std::vector<TruthGesture> truth;        // label point (with hold start and target), wave or stretch
   std::vector<std::pair<std::int64_t, std::int64_t>> rest;  // spans where the person stands at rest
   // Every frame of a pointing hold: the fused skeleton and the truth at that time, and the arm.
@@ -39,9 +42,39 @@ void learn_joint_offsets(const std::vector<SimSession>& sessions, PointingCorrec
 std::vector<double> whole_hold_target_errors(const std::vector<SimSession>& sessions, const PointingCorrection& c,
                                              const Surface& floor = {});
 
-// One session of the point scenario with this seed (people = 1, the default
-// two sensors). noise_scale scales the trackers' random errors (sim::SimConfig).
-SimSession simulate_session(std::uint64_t seed, const Surface& floor = {}, double noise_scale = 1.0);
+// One session of a scenario (the point scenario by default) with this seed
+// (the scenario's people, the default two sensors). noise_scale scales the
+// trackers' random errors (sim::SimConfig). Scenarios other than point have
+// no true gestures: every event spotted in them is a false alarm.
+SimSession simulate_session(std::uint64_t seed, const Surface& floor = {}, double noise_scale = 1.0,
+                            const std::string& scenario = "point");
+
+// The simulator's scenarios in which nobody gestures, what a worker does
+// besides: walk, 360, hide, box, occ, sit, arms, and work (a bench beside a
+// robot: reaching, picking and placing, carrying, turning to the robot,
+// scratching the head, glasses, a tool from a shelf at the side).
+const std::vector<std::string>& quiet_scenarios();
+
+// `per_scenario` sessions of each scenario, seeds (seed + 1) * 1000 + 700 + i
+// (none a training or test session of the point scenario has).
+std::vector<SimSession> quiet_sessions(const std::vector<std::string>& scenarios, int per_scenario, std::uint64_t seed,
+                                       const std::function<void(int done, int total)>& progress = {},
+                                       double noise_scale = 1.0);
+
+// False alarms: the events spotted in sessions where nobody gestures, per
+// scenario and class, against the time the fused stream covered.
+struct QuietReport {
+  struct Scenario {
+    std::string name;
+    double seconds = 0;
+    std::map<std::string, int> events;  // per class
+  };
+  std::vector<Scenario> scenarios;      // in the order given, sessions of one scenario summed
+  double hours = 0;
+  std::map<std::string, int> events;    // per class, every scenario
+  double per_hour(const std::string& label) const;
+};
+QuietReport spot_quiet(const Classifier& model, const std::vector<SimSession>& sessions, const SpotterOptions& options = {});
 
 // Labelled clips cut from sessions: each true gesture (action point, wave or
 // stretch; from `pad` s before to `pad` s after) and one rest clip per rest
