@@ -57,7 +57,7 @@ print(len(states), "states:", ", ".join(f"{k} {sum(s['state'] == k for s in stat
 PY
 ok "live: gesture states read over DDS, 'holding' during each pointing event"
 
-"$S" gesture sim --train-sessions 4 --test-sessions 2 --json >"$WORK/sim.json" 2>/dev/null || fail "gesture sim"
+"$S" gesture sim --train-sessions 4 --train-quiet-sessions 2 --test-sessions 2 --json >"$WORK/sim.json" 2>/dev/null || fail "gesture sim"
 json_check "$WORK/sim.json" 'd["spotting"]["truth"] == 12 and d["spotting"]["recall"] >= 0.8 and d["spotting"]["median_target_error_m"] < 0.4'
 # False alarms: a session of each scenario where nobody gestures, every event counted against its hours.
 python3 - "$WORK/sim.json" <<'PY' || fail "false alarms: $(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["false_alarms"])' "$WORK/sim.json")"
@@ -78,7 +78,7 @@ ok "offline: held-out simulated sessions scored, false alarms counted in eight s
 
 # The same sessions without the trackers' random errors: the targets land
 # within a few centimetres (what is left at noise 1 is the trackers' noise).
-"$S" gesture sim --train-sessions 4 --test-sessions 2 --test-noise-scale 0 --quiet-sessions 0 --json >"$WORK/sim0.json" 2>/dev/null || fail "gesture sim --test-noise-scale 0"
+"$S" gesture sim --train-sessions 4 --train-quiet-sessions 0 --test-sessions 2 --test-noise-scale 0 --quiet-sessions 0 --json >"$WORK/sim0.json" 2>/dev/null || fail "gesture sim --test-noise-scale 0"
 python3 - "$WORK/sim.json" "$WORK/sim0.json" <<'PY' || fail "noise-free test sessions"
 import json, sys
 a, b = (json.load(open(f)) for f in sys.argv[1:])

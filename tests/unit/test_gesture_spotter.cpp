@@ -198,8 +198,15 @@ std::vector<skelgraph::skeleton::Skeleton> arm_stream(const std::function<double
   return out;
 }
 
+// The tests here are not about where the ray lands: any ray counts unless a test says otherwise.
+SpotterOptions any_ray() {
+  SpotterOptions o;
+  o.max_target = 0;
+  return o;
+}
+
 std::vector<SpottedEvent> spot(const Classifier& c, const std::vector<skelgraph::skeleton::Skeleton>& stream,
-                               const SpotterOptions& o = {}) {
+                               const SpotterOptions& o = any_ray()) {
   Spotter sp(c, o);
   std::vector<SpottedEvent> events;
   for (const auto& s : stream) {
@@ -217,6 +224,29 @@ std::function<double(double)> gesture(double from, double angle) {
 }
 
 }  // namespace
+
+TEST(Spotting, PointingLandsWithinReachAndLeavesTheOtherArmFree) {
+  const auto c = always_point();
+  const SpotterOptions defaults;
+  // 70 degrees up from hanging from 1.45 m: the floor 4.2 m from the shoulder, beyond the default 4 m.
+  EXPECT_TRUE(spot(c, arm_stream(gesture(2.0, 70), 8), defaults).empty());
+  // 55 degrees: 2.5 m away, an event with its target.
+  const auto near = spot(c, arm_stream(gesture(2.0, 55), 8), defaults);
+  ASSERT_EQ(near.size(), 1u);
+  ASSERT_TRUE(near[0].has_target);
+  EXPECT_LT((near[0].target - near[0].ray_origin).norm(), 4.0);
+  // Both arms held out the same way (carrying, a stretch): no pointing; allowed when other_arm_free is off.
+  auto both = arm_stream(gesture(2.0, 55), 8);
+  for (auto& s : both) {
+    const Vector3d d = s[JointId::RightHand].position - s[JointId::RightShoulder].position;
+    s[JointId::LeftElbow].position = s[JointId::LeftShoulder].position + 0.5 * d;
+    s[JointId::LeftHand].position = s[JointId::LeftShoulder].position + d;
+  }
+  EXPECT_TRUE(spot(c, both, defaults).empty());
+  SpotterOptions allow = defaults;
+  allow.other_arm_free = false;
+  EXPECT_EQ(spot(c, both, allow).size(), 1u);
+}
 
 TEST(Spotting, AHangingArmIsNoPointing) {
   const auto c = always_point();

@@ -43,7 +43,7 @@ struct Section {
 // Pointing on simulated sessions: train on 8, spot in 4 held-out ones, score against the truth.
 Section pointing_section() {
   using namespace skelgraph::gesture;
-  const auto model = train_on_sim(8, 1, sim_classifier_options());
+  const auto model = train_on_sim(kTrainSessions, 1, sim_classifier_options());
   const auto sessions = held_out_sessions(4, 1);
   std::vector<SpottingReport> reports;
   std::string rows;

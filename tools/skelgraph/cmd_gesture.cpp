@@ -57,10 +57,11 @@ struct GestureOptions {
   bool sweep = false;
   bool nested = false;
   // sim
-  int train_sessions = 8, test_sessions = 4;
+  int train_sessions = kTrainSessions, test_sessions = 4;
   double test_noise_scale = 1.0;  // gesture sim: the test sessions' tracker noise
   std::vector<std::string> quiet_scenarios = gesture::quiet_scenarios();  // gesture sim: where nobody gestures
   int quiet_sessions = 1;                                                  // ... sessions of each
+  int train_quiet_sessions = kTrainQuietSessions;                          // ... to train against (hard negatives)
   SpotterOptions spot;
   double gap = 0.0;
   double rest = 0.0;
@@ -428,7 +429,8 @@ int gesture_sim(const GestureOptions& o) {
   };
   std::size_t clips = 0;
   const auto model = train_on_sim(o.train_sessions, o.seed, c, &clips,
-                                  [&](int d, int t) { progress("simulating and fusing training sessions", d, t); }, o.spot);
+                                  [&](int d, int t) { progress("simulating and fusing training sessions", d, t); }, o.spot,
+                                  o.train_quiet_sessions);
   if (!o.out.empty()) model.save(o.out);
   const auto test = held_out_sessions(o.test_sessions, o.seed, [&](int d, int t) { progress("simulating and fusing test sessions", d, t); },
                                       o.test_noise_scale);
@@ -442,7 +444,11 @@ int gesture_sim(const GestureOptions& o) {
                             {"scenarios", nlohmann::json::array()}};
   for (const auto& [label, n] : quiet.events) quiet_json["per_hour"][label] = quiet.per_hour(label);
   quiet_json["per_hour"]["point"] = quiet.per_hour("point");
-  for (const auto& s : quiet.scenarios) quiet_json["scenarios"].push_back({{"scenario", s.name}, {"seconds", s.seconds}, {"events", s.events}});
+  for (const auto& s : quiet.scenarios) {
+    nlohmann::json false_events = nlohmann::json::array();
+    for (const auto& e : s.spotted) false_events.push_back(event_json(e));
+    quiet_json["scenarios"].push_back({{"scenario", s.name}, {"seconds", s.seconds}, {"events", s.events}, {"spotted", false_events}});
+  }
   std::vector<SpottedEvent> events;
   std::vector<SpottingReport> reports;
   nlohmann::json per = nlohmann::json::array();
@@ -588,6 +594,14 @@ void add_spotter_options(CLI::App* c, GestureOptions& o) {
   c->add_option("--min-raise", o.spot.min_raise,
                 "degrees from hanging straight down an extended arm must be raised to count as a pointing hold (default 35)")
       ->check(CLI::Range(0.0, 180.0));
+  c->add_option("--max-target", o.spot.max_target,
+                "m: pointing must land on a surface within this of the shoulder (default 4; 0: any ray, none needed)")
+      ->check(CLI::Range(0.0, 100.0));
+  c->add_option("--other-arm-free", o.spot.other_arm_free,
+                "pointing needs the other arm not held out as well (default true)");
+  c->add_option("--min-confidence", o.spot.min_confidence,
+                "events less sure than this (1 - exp(-margin) over the next class) are dropped (default 0)")
+      ->check(CLI::Range(0.0, 1.0));
 }
 
 }  // namespace
@@ -642,7 +656,7 @@ void add_gesture_command(CLI::App& app, GlobalOptions&, Action& run) {
                                      "gestures in the others' fused stream and score precision, recall, latency and target error");
   sm->add_flag("--json", o->json, "machine-readable output");
   add_model_options(sm, *o);
-  sm->add_option("--train-sessions", o->train_sessions, "sessions to train on (default 8)")->check(CLI::Range(1, 200));
+  sm->add_option("--train-sessions", o->train_sessions, "pointing sessions to train on (default 24)")->check(CLI::Range(1, 200));
   sm->add_option("--test-sessions", o->test_sessions, "sessions to spot on (default 4)")->check(CLI::Range(1, 200));
   sm->add_option("--test-noise-scale", o->test_noise_scale,
                  "scale of the trackers' random errors in the test sessions (default 1; 0 leaves the skeleton convention's "
@@ -653,6 +667,9 @@ void add_gesture_command(CLI::App& app, GlobalOptions&, Action& run) {
       ->delimiter(',')
       ->check(CLI::IsMember(sim::scenario_names()));
   sm->add_option("--quiet-sessions", o->quiet_sessions, "sessions of each of them (default 1; 0: none)")->check(CLI::Range(0, 200));
+  sm->add_option("--train-quiet-sessions", o->train_quiet_sessions,
+                 "training sessions of each of them whose false alarms the model is trained again against (default 8; 0: none)")
+      ->check(CLI::Range(0, 200));
   sm->add_option("--out", o->out, "write the trained classifier (JSON), e.g. for the gesture component");
   add_spotter_options(sm, *o);
   sm->add_option("--window", o->spot.window, "s over which hand speed is measured (default 0.25)")->check(CLI::Range(0.03, 2.0));

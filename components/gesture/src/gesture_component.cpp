@@ -23,9 +23,10 @@ Classifier load_model(const std::string& path, const std::string& who) {
   if (path.empty())
     throw std::invalid_argument("model: no classifier given (a file from `skelgraph gesture train` or `gesture sim --out`, or 'sim')");
   if (path == "sim") {
-    spdlog::info("{}: training the pointing classifier on 8 simulated sessions ...", who);
+    spdlog::info("{}: training the pointing classifier on {} simulated sessions and false alarms in {} of each quiet scenario ...",
+                 who, kTrainSessions, kTrainQuietSessions);
     std::size_t clips = 0;
-    auto c = train_on_sim(8, 1, sim_classifier_options(), &clips);
+    auto c = train_on_sim(kTrainSessions, 1, sim_classifier_options(), &clips);
     spdlog::info("{}: trained on {} clips", who, clips);
     return c;
   }
@@ -64,6 +65,8 @@ runtime::ComponentInfo GestureComponent::describe() {
                   0.0, 10.0)
       .add_double("still_speed", 0.25, "a hand slower than this is still, m/s", 0.01, 5.0)
       .add_double("min_raise_deg", 35.0, "an extended arm counts as pointing only raised this far from hanging straight down", 0.0, 180.0)
+      .add_double("max_target_m", 4.0, "pointing must land on a surface within this of the shoulder (0: any ray)", 0.0, 100.0)
+      .add_bool("other_arm_free", true, "pointing needs the other arm not held out as well (carrying, a stretch)")
       .add_double("person_timeout_ms", 2000.0, "a person not seen this long is forgotten", 10.0, 60000.0);
   return info;
 }
@@ -87,6 +90,8 @@ GestureComponent::GestureComponent(runtime::Context& ctx, const runtime::Params&
   options_.aim = params.get<double>("aim_s");
   options_.still_speed = params.get<double>("still_speed");
   options_.min_raise = params.get<double>("min_raise_deg");
+  options_.max_target = params.get<double>("max_target_m");
+  options_.other_arm_free = params.get<bool>("other_arm_free");
   options_.surfaces.clear();
   const auto surfaces = runtime::rejoin_named_items(params.get<std::vector<std::string>>("surfaces"));
   for (const auto& s : surfaces) options_.surfaces.push_back(parse_surface(s));

@@ -182,23 +182,31 @@ ClassMap sim_class_map() {
   return m;
 }
 
+namespace {
+// The session's fused frames from..to as a clip of `action` (none: fewer than 5 frames).
+void cut_clip(const SimSession& s, std::int64_t from, std::int64_t to, const std::string& action, const std::string& subject,
+              const ClassMap& map, FeatureSet set, std::vector<Clip>& clips) {
+  std::vector<skeleton::Skeleton> frames;
+  for (const auto& f : s.fused)
+    if (f.stamp_ns >= from && f.stamp_ns <= to) frames.push_back(f);
+  if (frames.size() < 5) return;
+  Clip c;
+  c.action = action;
+  c.subject = subject;
+  c.source = c.subject + ":" + action + "@" + std::to_string(from);
+  c.label = map.label_of(action).value_or(-1);
+  c.x = features_of(frames, FeatureOptions{set, skeleton::kTracked}).x;
+  clips.push_back(std::move(c));
+}
+}  // namespace
+
 std::vector<Clip> session_clips(const std::vector<SimSession>& sessions, const ClassMap& map, FeatureSet set, double pad) {
   std::vector<Clip> clips;
   const auto pad_ns = static_cast<std::int64_t>(pad * 1e9);
   for (std::size_t n = 0; n < sessions.size(); ++n) {
     const auto& s = sessions[n];
     const auto cut = [&](std::int64_t from, std::int64_t to, const std::string& action) {
-      std::vector<skeleton::Skeleton> frames;
-      for (const auto& f : s.fused)
-        if (f.stamp_ns >= from && f.stamp_ns <= to) frames.push_back(f);
-      if (frames.size() < 5) return;
-      Clip c;
-      c.action = action;
-      c.subject = "sim" + std::to_string(n);
-      c.source = c.subject + ":" + action + "@" + std::to_string(from);
-      c.label = map.label_of(action).value_or(-1);
-      c.x = features_of(frames, FeatureOptions{set, skeleton::kTracked}).x;
-      clips.push_back(std::move(c));
+      cut_clip(s, from, to, action, "sim" + std::to_string(n), map, set, clips);
     };
     for (const auto& g : s.truth) cut(g.start_ns - pad_ns, g.end_ns + pad_ns, g.label);
     for (const auto& [a, b] : s.rest)
@@ -227,12 +235,13 @@ const std::vector<std::string>& quiet_scenarios() {
 }
 
 std::vector<SimSession> quiet_sessions(const std::vector<std::string>& scenarios, int per_scenario, std::uint64_t seed,
-                                       const std::function<void(int, int)>& progress, double noise_scale) {
+                                       const std::function<void(int, int)>& progress, double noise_scale, bool training) {
   std::vector<SimSession> out;
   const int total = per_scenario * static_cast<int>(scenarios.size());
+  const std::uint64_t first = training ? seed * 1000 + 300 : (seed + 1) * 1000 + 700;
   for (const auto& name : scenarios) {
     for (int i = 0; i < per_scenario; ++i) {
-      out.push_back(simulate_session((seed + 1) * 1000 + 700 + static_cast<std::uint64_t>(i), {}, noise_scale, name));
+      out.push_back(simulate_session(first + static_cast<std::uint64_t>(i), {}, noise_scale, name));
       if (progress) progress(static_cast<int>(out.size()), total);
     }
   }
@@ -250,7 +259,7 @@ QuietReport spot_quiet(const Classifier& model, const std::vector<SimSession>& s
   for (std::size_t n = 0; n < sessions.size(); ++n) {
     const auto& s = sessions[n];
     auto it = std::find_if(r.scenarios.begin(), r.scenarios.end(), [&](const auto& x) { return x.name == s.scenario; });
-    if (it == r.scenarios.end()) it = r.scenarios.insert(r.scenarios.end(), QuietReport::Scenario{s.scenario, 0, {}});
+    if (it == r.scenarios.end()) it = r.scenarios.insert(r.scenarios.end(), QuietReport::Scenario{s.scenario, 0, {}, {}});
     if (!s.fused.empty()) {
       const double seconds = static_cast<double>(s.fused.back().stamp_ns - s.fused.front().stamp_ns) * 1e-9;
       it->seconds += seconds;
@@ -259,6 +268,7 @@ QuietReport spot_quiet(const Classifier& model, const std::vector<SimSession>& s
     for (const auto& e : spotted[n].events) {
       ++it->events[e.label];
       ++r.events[e.label];
+      it->spotted.push_back(e);
     }
   }
   return r;
@@ -287,21 +297,39 @@ ClassifierOptions sim_classifier_options() {
 }
 
 Classifier train_on_sim(int sessions, std::uint64_t seed, const ClassifierOptions& options, std::size_t* clips,
-                        const std::function<void(int, int)>& progress, const SpotterOptions& spot) {
+                        const std::function<void(int, int)>& progress, const SpotterOptions& spot_options, int quiet_per_scenario) {
+  // Training sees every event, however unsure: the operating point is the user's, at spotting time.
+  SpotterOptions spot = spot_options;
+  spot.min_confidence = 0.0;
   std::vector<SimSession> train;
   for (int i = 0; i < sessions; ++i) {
     train.push_back(simulate_session(seed * 1000 + static_cast<std::uint64_t>(i)));
     if (progress) progress(i + 1, sessions);
   }
   const auto map = sim_class_map();
-  const auto c = session_clips(train, map, options.features.set);
-  if (clips) *clips = c.size();
+  auto c = session_clips(train, map, options.features.set);
   auto model = Classifier::train(c, map, options);
   // The pointing correction: first the joints' offsets, then the median
   // angles by which the rays spotted from the corrected joints still miss the true ones.
   PointingCorrection pc;
   learn_joint_offsets(train, pc);
   model.set_pointing_correction(pc);
+  // Hard negatives: what this model takes for pointing in training sessions
+  // where nobody gestures (work, carrying, sitting...), cut as the spotter
+  // cut it, joins the garbage class; then trained again.
+  if (quiet_per_scenario > 0) {
+    const auto quiet = quiet_sessions(quiet_scenarios(), quiet_per_scenario, seed, {}, 1.0, true);
+    const auto spotted = spot_sessions(model, quiet, spot);
+    const auto pad_ns = static_cast<std::int64_t>(spot.pad * 1e9);
+    for (std::size_t n = 0; n < quiet.size(); ++n) {
+      for (const auto& e : spotted[n].events) {
+        cut_clip(quiet[n], e.start_ns - pad_ns, e.end_ns, "work", "quiet" + std::to_string(n), map, options.features.set, c);
+      }
+    }
+    model = Classifier::train(c, map, options);
+    model.set_pointing_correction(pc);
+  }
+  if (clips) *clips = c.size();
   std::vector<double> el, az;
   const auto spotted = spot_sessions(model, train, spot);
   for (std::size_t n = 0; n < train.size(); ++n)

@@ -183,13 +183,20 @@ std::vector<SpottedEvent> Spotter::step(const skeleton::Skeleton& s, const Wrist
       const ArmFrame arm(across_, side == 1);
       const auto& pc = c_.pointing_correction();
       const Vector3d sh0 = sh - arm.to_world(pc.shoulder), ha0 = ha - arm.to_world(pc.hand);
-      rays_[side].push_back({t, sh0, (ha0 - sh0).normalized()});
+      rays_[side].push_back({t, sh0, (ha0 - sh0).normalized(), false});
       if (aiming_ && aiming_side_ == side && static_cast<double>(t - hold_since_[side]) * 1e-9 >= o_.aim) send_aimed(side, false);
       if (rays_[side].size() > best_rays_.size()) best_rays_ = rays_[side], best_side_ = side;
     } else {
       send_aimed(side, true);
       hold_since_[side] = -1;
       rays_[side].clear();
+    }
+  }
+  // A ray of this frame with the other arm held out (extended and still) as well.
+  for (int side = 0; side < 2; ++side) {
+    if (hold_since_[side] >= 0 && hold_since_[1 - side] >= 0 && !rays_[side].empty() && rays_[side].back().t == t) {
+      rays_[side].back().both = true;
+      if (best_side_ == side && !best_rays_.empty() && best_rays_.back().t == t) best_rays_.back().both = true;
     }
   }
   have_last_ = true;
@@ -318,6 +325,7 @@ std::optional<SpottedEvent> Spotter::decide(std::int64_t now_ns, bool early) {
   e.end_ns = now_ns;
   e.log_likelihood = d.scores[static_cast<std::size_t>(d.label)];
   e.confidence = 1.0 - std::exp(-std::max(0.0, d.margin));
+  if (e.confidence < o_.min_confidence) return std::nullopt;
   if (point) {
     // Early: the arm held out now; at the end: the segment's longest hold.
     int side = -1;
@@ -328,6 +336,11 @@ std::optional<SpottedEvent> Spotter::decide(std::int64_t now_ns, bool early) {
     if (!now) side = best_side_;
     aim(e, rays, side);
     if (!e.has_ray) return std::nullopt;  // no arm was held out: whatever the models say, this was not pointing
+    if (o_.other_arm_free) {
+      const auto both = std::count_if(rays.begin(), rays.end(), [](const RaySample& r) { return r.both; });
+      if (2 * both > static_cast<std::ptrdiff_t>(rays.size())) return std::nullopt;  // both arms out: not pointing
+    }
+    if (o_.max_target > 0 && (!e.has_target || (e.target - e.ray_origin).norm() > o_.max_target)) return std::nullopt;
   }
   return e;
 }

@@ -13,12 +13,13 @@
 
 #include <Eigen/Geometry>
 
+#include "skelgraph/gesture/sim_sessions.hpp"
 #include "skelgraph/robot/fetch.hpp"
 
 namespace skelgraph::eval {
 
 struct FetchRunOptions {
-  int train_sessions = 8;
+  int train_sessions = gesture::kTrainSessions;
   int sessions = 8;  // held out
   std::uint64_t seed = 1;
   Eigen::Isometry3d world_from_base = Eigen::Isometry3d::Identity();

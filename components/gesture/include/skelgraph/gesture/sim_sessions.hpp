@@ -56,10 +56,11 @@ SimSession simulate_session(std::uint64_t seed, const Surface& floor = {}, doubl
 const std::vector<std::string>& quiet_scenarios();
 
 // `per_scenario` sessions of each scenario, seeds (seed + 1) * 1000 + 700 + i
-// (none a training or test session of the point scenario has).
+// (none a training or test session of the point scenario has); for training,
+// seed * 1000 + 300 + i (none of those either).
 std::vector<SimSession> quiet_sessions(const std::vector<std::string>& scenarios, int per_scenario, std::uint64_t seed,
                                        const std::function<void(int done, int total)>& progress = {},
-                                       double noise_scale = 1.0);
+                                       double noise_scale = 1.0, bool training = false);
 
 // False alarms: the events spotted in sessions where nobody gestures, per
 // scenario and class, against the time the fused stream covered.
@@ -68,6 +69,7 @@ struct QuietReport {
     std::string name;
     double seconds = 0;
     std::map<std::string, int> events;  // per class
+    std::vector<SpottedEvent> spotted;  // every one of them
   };
   std::vector<Scenario> scenarios;      // in the order given, sessions of one scenario summed
   double hours = 0;
@@ -102,10 +104,19 @@ struct SessionSpotting {
 std::vector<SessionSpotting> spot_sessions(const Classifier& model, const std::vector<SimSession>& sessions,
                                            const SpotterOptions& options = {});
 
+// The default training: pointing sessions, and sessions of each quiet
+// scenario whose false alarms it is trained again against (the best
+// measured: docs/experiments/2026-12-04-quiet-gestures.md).
+constexpr int kTrainSessions = 24;
+constexpr int kTrainQuietSessions = 8;
+
 // A classifier trained on `sessions` simulated sessions (seeds seed*1000 + i),
-// and the clips it was trained on (count) for reports.
+// and the clips it was trained on (count) for reports. With
+// quiet_per_scenario > 0, what a first model spots in that many training
+// sessions of each quiet scenario is added as "other" and it is trained again.
 // The pointing correction is learnt by spotting the training sessions with `spot`.
 Classifier train_on_sim(int sessions, std::uint64_t seed, const ClassifierOptions& options, std::size_t* clips = nullptr,
-                        const std::function<void(int done, int total)>& progress = {}, const SpotterOptions& spot = {});
+                        const std::function<void(int done, int total)>& progress = {}, const SpotterOptions& spot = {},
+                        int quiet_per_scenario = kTrainQuietSessions);
 
 }  // namespace skelgraph::gesture

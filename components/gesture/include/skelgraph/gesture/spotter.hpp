@@ -74,6 +74,10 @@ struct SpotterOptions {
   double min_raise = 35.0;     // ...with the shoulder -> hand line at least this many degrees from hanging straight down
   double min_length = 0.4;     // s: shorter segments are ignored
   double max_length = 10.0;    // s: longer ones are cut (classified and reopened)
+  // Pointing, told from work that holds an arm out (docs/experiments/2026-12-04-quiet-gestures.md):
+  double max_target = 4.0;     // m: the ray must meet a surface within this of the shoulder (0: any ray, none needed)
+  bool other_arm_free = true;  // the other arm not held out as well (carrying, a stretch, hands on the knees)
+  double min_confidence = 0.0; // events less sure than this are dropped (the operating point: recall against false alarms)
   std::string point_label = "point";
   std::vector<Surface> surfaces{Surface{}};  // the ray's target: the nearest hit
 };
@@ -128,6 +132,7 @@ class Spotter {
   struct RaySample {
     std::int64_t t;
     Eigen::Vector3d origin, direction;
+    bool both = false;  // the other arm was held out too
   };
   using Rays = std::vector<RaySample>;
   void aim(SpottedEvent& e, const Rays& rays, int side) const;  // the ray and its target
