@@ -9,20 +9,26 @@
 # `unshare -n`. NOISE_SCALE (default 1) scales the simulated trackers' random
 # errors (the sim's noise_scale; 0 leaves the skeleton convention's offsets,
 # the lag and the geometry): how far the targets are off without that noise.
-# Usage: bench/gesture_live.sh BUILD_DIR [SECONDS] [NOISE_SCALE]
+# SCENARIO (default point) runs another simulator scenario instead; in one
+# where nobody gestures (walk, 360, hide, box, occ, sit, arms, work) every
+# event is a false alarm, reported per hour (false_events_per_hour).
+# Usage: bench/gesture_live.sh BUILD_DIR [SECONDS] [NOISE_SCALE] [SCENARIO]
 set -euo pipefail
-build=${1:?usage: gesture_live.sh BUILD_DIR [SECONDS] [NOISE_SCALE]}
+build=${1:?usage: gesture_live.sh BUILD_DIR [SECONDS] [NOISE_SCALE] [SCENARIO]}
 seconds=${2:-60}
 noise=${3:-1}
+scenario=${4:-point}
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 sg="$build/bin/skelgraph"
 launch="$root/bringup/gesture_sim.yaml"
-if [[ "$noise" != 1 ]]; then
+if [[ "$noise" != 1 || "$scenario" != point ]]; then
   launch="$work/gesture_sim.yaml"
-  sed "s/^      loop: true\$/      loop: true\n      noise_scale: $noise/" "$root/bringup/gesture_sim.yaml" >"$launch"
-  grep -q "noise_scale: $noise" "$launch" || { echo "gesture_live.sh: could not set noise_scale in $launch" >&2; exit 2; }
+  sed "s/^      loop: true\$/      loop: true\n      noise_scale: $noise/; s/^      scenario: point\$/      scenario: $scenario/" \
+    "$root/bringup/gesture_sim.yaml" >"$launch"
+  grep -q "noise_scale: $noise" "$launch" && grep -q "scenario: $scenario" "$launch" ||
+    { echo "gesture_live.sh: could not set noise_scale and scenario in $launch" >&2; exit 2; }
 fi
 unshare -n bash -c '
   set -e
@@ -34,9 +40,9 @@ unshare -n bash -c '
   sleep 1
   kill $tp $ep 2>/dev/null || true
 ' _ "$root" "$sg" "$work" "$seconds" "$launch"
-python3 - "$work" "$seconds" "$noise" <<'PY'
+python3 - "$work" "$seconds" "$noise" "$scenario" <<'PY'
 import bisect, json, math, statistics, sys
-work, seconds, noise = sys.argv[1], float(sys.argv[2]), float(sys.argv[3])
+work, seconds, noise, scenario = sys.argv[1], float(sys.argv[2]), float(sys.argv[3]), sys.argv[4]
 truth = [json.loads(l)["data"] for l in open(work + "/truth.json") if l.strip()]
 events = [json.loads(l)["data"] for l in open(work + "/events.json") if l.strip()]
 stamps = [t["stamp_ns"] for t in truth]
@@ -79,7 +85,10 @@ for e in events:
             row.update(true_target=tt, target=[e["target"][c] for c in "xyz"], error_m=err, held_frames=len(hits))
             errors.append(err)
     out.append(row)
-print(json.dumps({"seconds": seconds, "noise_scale": noise, "events": len(events), "scored": len(errors),
-                  "median_target_error_m": statistics.median(errors) if errors else None,
-                  "within_15_cm": sum(e <= 0.15 for e in errors), "per_event": out}, indent=2))
+result = {"scenario": scenario, "seconds": seconds, "noise_scale": noise, "events": len(events), "scored": len(errors),
+          "median_target_error_m": statistics.median(errors) if errors else None,
+          "within_15_cm": sum(e <= 0.15 for e in errors), "per_event": out}
+if scenario != "point":  # nobody gestures: every event is a false alarm
+    result["false_events_per_hour"] = {l: 3600.0 * sum(e["label"] == l for e in events) / seconds for l in sorted({e["label"] for e in events})}
+print(json.dumps(result, indent=2))
 PY

@@ -26,6 +26,8 @@ assert r["missed_steps"] == 0 and r["stops"] >= 1 and 0 < r["stop_pct"] < 100 an
 assert os.path.exists(os.path.join(os.path.dirname(d["report"]), "robot_state.svg"))
 p = d["pointing"]
 assert p["truth"] == 24 and p["recall"] >= 0.8 and p["precision"] >= 0.8 and p["median_target_error_m"] < 0.4, p
+assert p["quiet_hours"] > 0.05 and p["false_points_per_hour"] >= 0, p   # false alarms measured beside F1
+assert "false pointing events per hour" in open(d["report"]).read()
 c = {x["name"]: x for x in d["components"]}
 assert all(x["state"] == "OK" for x in c.values()), {k: (v["state"], v["message"]) for k, v in c.items()}
 methods = ("avg", "sum", "facing", "weighted", "kalman")

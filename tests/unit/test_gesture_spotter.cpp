@@ -248,6 +248,24 @@ TEST(Spotting, PointingLandsWithinReachAndLeavesTheOtherArmFree) {
   EXPECT_EQ(spot(c, both, allow).size(), 1u);
 }
 
+TEST(Spotting, AConfirmationDropsPointingHeldBriefly) {
+  const auto c = always_point();
+  // Raised over 0.5 s to 55 degrees at 2 s, held `hold` s, lowered over 0.5 s.
+  const auto brief = [](double hold) {
+    return [hold](double t) {
+      const double u = std::clamp((t - 2.0) / 0.5, 0.0, 1.0) - std::clamp((t - 2.5 - hold) / 0.5, 0.0, 1.0);
+      return 55.0 * u;
+    };
+  };
+  SpotterOptions o = any_ray();
+  EXPECT_EQ(spot(c, arm_stream(brief(0.8), 6), o).size(), 1u);  // no confirmation: held 0.8 s is pointing
+  o.confirm = 1.0;
+  EXPECT_TRUE(spot(c, arm_stream(brief(0.8), 6), o).empty());  // 0.25 + 1.0 s needed
+  const auto long_hold = spot(c, arm_stream(brief(2.5), 8), o);
+  ASSERT_EQ(long_hold.size(), 1u);                               // held long enough: still sent
+  EXPECT_TRUE(long_hold[0].has_ray);
+}
+
 TEST(Spotting, AHangingArmIsNoPointing) {
   const auto c = always_point();
   // Pointing at the floor ahead (70 degrees up from hanging): one event, its ray that way.

@@ -343,8 +343,10 @@ int gesture_spot(const GestureOptions& o) {
   const auto& t = r.combined;
   std::printf("leave-subject-out spotting in continuous streams of %zu clips (%.1f s of the last frame held, %.1f s of arms-down rest "
               "between them):\n", clips.size(), o.gap, o.rest);
-  std::printf("%s: %d true, %d events: precision %.3f recall %.3f F1 %.3f; latency from the end of the motion: median %.0f ms\n",
-              r.label.c_str(), t.truth, t.events, t.precision, t.recall, t.f1, 1e3 * t.median_latency_s);
+  std::printf("%s: %d true, %d events: precision %.3f recall %.3f F1 %.3f; %.1f false events per hour of the streams outside "
+              "its clips (%.2f h); latency from the end of the motion: median %.0f ms\n",
+              r.label.c_str(), t.truth, t.events, t.precision, t.recall, t.f1, t.false_per_hour, t.non_gesture_s / 3600.0,
+              1e3 * t.median_latency_s);
   return 0;
 }
 
@@ -513,7 +515,8 @@ int gesture_sim(const GestureOptions& o) {
   }
   std::printf("trained on %zu clips of %d simulated sessions%s; spotted on %d others:\n", clips, o.train_sessions,
               o.out.empty() ? "" : (" (model: " + o.out + ")").c_str(), o.test_sessions);
-  std::printf("pointing: %d true, %d events: precision %.3f recall %.3f F1 %.3f\n", r.truth, r.events, r.precision, r.recall, r.f1);
+  std::printf("pointing: %d true, %d events: precision %.3f recall %.3f F1 %.3f; %.1f false events per hour between the gestures\n",
+              r.truth, r.events, r.precision, r.recall, r.f1, r.false_per_hour);
   const auto& pc = model.pointing_correction();
   std::printf("pointing correction learnt on the training sessions: shoulder off by (%.1f, %.1f, %.1f) cm and hand by "
               "(%.1f, %.1f, %.1f) cm (out, up, forward); then rays lowered %.1f deg, turned in %.1f deg\n",
@@ -599,6 +602,9 @@ void add_spotter_options(CLI::App* c, GestureOptions& o) {
       ->check(CLI::Range(0.0, 100.0));
   c->add_option("--other-arm-free", o.spot.other_arm_free,
                 "pointing needs the other arm not held out as well (default true)");
+  c->add_option("--confirm", o.spot.confirm,
+                "s pointing must stay held after --hold before the event goes out, or it is dropped (default 0: none)")
+      ->check(CLI::Range(0.0, 10.0));
   c->add_option("--min-confidence", o.spot.min_confidence,
                 "events less sure than this (1 - exp(-margin) over the next class) are dropped (default 0)")
       ->check(CLI::Range(0.0, 1.0));

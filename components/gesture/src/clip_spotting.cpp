@@ -154,6 +154,14 @@ ClipSpotting spot_clips(const std::vector<Clip>& clips, const ClassMap& map, con
     s.subject = subject;
     s.clips = idx.size();
     s.report = score_spotting(events, st.truth, out.label);
+    if (!st.frames.empty()) {  // the stream outside the clips of the spotted class
+      double inside = 0;
+      for (std::size_t k = 0; k < st.ranges.size() && k < st.truth.size(); ++k) {
+        if (st.truth[k].label == out.label) inside += 1e-9 * static_cast<double>(st.ranges[k].end_ns - st.ranges[k].start_ns);
+      }
+      s.report.non_gesture_s = 1e-9 * static_cast<double>(st.frames.back().stamp_ns - st.frames.front().stamp_ns) - inside;
+      finish(s.report);
+    }
     reports.push_back(s.report);
     s.spotted = nlohmann::json::array();
     const std::int64_t origin = st.frames.empty() ? 0 : st.frames.front().stamp_ns;

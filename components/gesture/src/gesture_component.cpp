@@ -67,6 +67,8 @@ runtime::ComponentInfo GestureComponent::describe() {
       .add_double("min_raise_deg", 35.0, "an extended arm counts as pointing only raised this far from hanging straight down", 0.0, 180.0)
       .add_double("max_target_m", 4.0, "pointing must land on a surface within this of the shoulder (0: any ray)", 0.0, 100.0)
       .add_bool("other_arm_free", true, "pointing needs the other arm not held out as well (carrying, a stretch)")
+      .add_double("confirm_s", 0.0, "pointing must stay held this long after hold_s or it is dropped (a confirmation)", 0.0, 10.0)
+      .add_double("min_confidence", 0.0, "events less sure than this (1 - exp(-margin) over the next class) are dropped", 0.0, 1.0)
       .add_double("person_timeout_ms", 2000.0, "a person not seen this long is forgotten", 10.0, 60000.0);
   return info;
 }
@@ -92,6 +94,8 @@ GestureComponent::GestureComponent(runtime::Context& ctx, const runtime::Params&
   options_.min_raise = params.get<double>("min_raise_deg");
   options_.max_target = params.get<double>("max_target_m");
   options_.other_arm_free = params.get<bool>("other_arm_free");
+  options_.confirm = params.get<double>("confirm_s");
+  options_.min_confidence = params.get<double>("min_confidence");
   options_.surfaces.clear();
   const auto surfaces = runtime::rejoin_named_items(params.get<std::vector<std::string>>("surfaces"));
   for (const auto& s : surfaces) options_.surfaces.push_back(parse_surface(s));

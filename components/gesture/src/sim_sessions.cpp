@@ -283,6 +283,13 @@ std::vector<SessionSpotting> spot_sessions(const Classifier& model, const std::v
     for (const auto& f : s.fused)
       for (const auto& e : spotters.try_emplace(f.person_id, model, options).first->second.step(f)) r.events.push_back(e);
     r.report = score_spotting(r.events, s.truth, "point");
+    if (!s.fused.empty()) {  // the session outside its pointing gestures
+      double inside = 0;
+      for (const auto& g : s.truth)
+        if (g.label == "point") inside += 1e-9 * static_cast<double>(g.end_ns - g.start_ns);
+      r.report.non_gesture_s = 1e-9 * static_cast<double>(s.fused.back().stamp_ns - s.fused.front().stamp_ns) - inside;
+      finish(r.report);
+    }
     out.push_back(std::move(r));
   }
   return out;
@@ -298,9 +305,10 @@ ClassifierOptions sim_classifier_options() {
 
 Classifier train_on_sim(int sessions, std::uint64_t seed, const ClassifierOptions& options, std::size_t* clips,
                         const std::function<void(int, int)>& progress, const SpotterOptions& spot_options, int quiet_per_scenario) {
-  // Training sees every event, however unsure: the operating point is the user's, at spotting time.
+  // Training sees every event, however unsure or short: the operating point is the user's, at spotting time.
   SpotterOptions spot = spot_options;
   spot.min_confidence = 0.0;
+  spot.confirm = 0.0;
   std::vector<SimSession> train;
   for (int i = 0; i < sessions; ++i) {
     train.push_back(simulate_session(seed * 1000 + static_cast<std::uint64_t>(i)));

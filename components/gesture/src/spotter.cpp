@@ -126,6 +126,10 @@ std::vector<SpottedEvent> Spotter::step(const skeleton::Skeleton& s, const Wrist
   // (or when it was decided, if that was later).
   const auto send_aimed = [&](int side, bool moving) {
     if (!aiming_ || aiming_side_ != side) return;
+    if (moving && static_cast<double>(t - aiming_hold_ns_) * 1e-9 < o_.hold + o_.confirm) {
+      aiming_.reset();  // not held long enough to confirm it
+      return;
+    }
     auto& rays = rays_[side];
     const auto cut = t - static_cast<std::int64_t>(o_.window * 1e9);
     if (moving) {
@@ -184,7 +188,9 @@ std::vector<SpottedEvent> Spotter::step(const skeleton::Skeleton& s, const Wrist
       const auto& pc = c_.pointing_correction();
       const Vector3d sh0 = sh - arm.to_world(pc.shoulder), ha0 = ha - arm.to_world(pc.hand);
       rays_[side].push_back({t, sh0, (ha0 - sh0).normalized(), false});
-      if (aiming_ && aiming_side_ == side && static_cast<double>(t - hold_since_[side]) * 1e-9 >= o_.aim) send_aimed(side, false);
+      if (aiming_ && aiming_side_ == side && static_cast<double>(t - hold_since_[side]) * 1e-9 >= std::max(o_.aim, o_.hold + o_.confirm)) {
+        send_aimed(side, false);
+      }
       if (rays_[side].size() > best_rays_.size()) best_rays_ = rays_[side], best_side_ = side;
     } else {
       send_aimed(side, true);
@@ -226,8 +232,9 @@ std::vector<SpottedEvent> Spotter::step(const skeleton::Skeleton& s, const Wrist
     for (int side = 0; side < 2; ++side) {
       if (hold_since_[side] < 0 || static_cast<double>(t - hold_since_[side]) * 1e-9 < o_.hold) continue;
       if (auto e = decide(t, true)) {
-        if (o_.aim > o_.hold) {  // decided; the ray is gathered until the arm moves or `aim` has passed
+        if (o_.aim > o_.hold || o_.confirm > 0) {  // decided; the ray is gathered until the arm moves or `aim` has passed
           aiming_side_ = e->arm == kSideName[1] ? 1 : 0;
+          aiming_hold_ns_ = hold_since_[aiming_side_];
           aiming_ = std::move(e);
         } else {
           out.push_back(*e);
@@ -255,8 +262,10 @@ std::vector<SpottedEvent> Spotter::step(const skeleton::Skeleton& s, const Wrist
 
 std::vector<SpottedEvent> Spotter::close(std::int64_t now_ns, bool final) {
   std::vector<SpottedEvent> out;
-  if (aiming_)  // the segment ends while the ray is still being gathered (a hold cut short by the end of data)
-    out.push_back(release_aiming(rays_[aiming_side_].empty() ? best_rays_ : rays_[aiming_side_], now_ns));
+  if (aiming_) {  // the segment ends while the ray is still being gathered (a hold cut short by the end of data)
+    if (static_cast<double>(now_ns - aiming_hold_ns_) * 1e-9 < o_.hold + o_.confirm) aiming_.reset();  // unconfirmed
+    else out.push_back(release_aiming(rays_[aiming_side_].empty() ? best_rays_ : rays_[aiming_side_], now_ns));
+  }
   const double length = segment_.empty() ? 0.0 : static_cast<double>(segment_.back().t - segment_.front().t) * 1e-9;
   if (!fired_ && length >= o_.min_length) {
     if (auto e = decide(now_ns, false)) out.push_back(*e);
@@ -391,6 +400,7 @@ SpottingReport combine(const std::vector<SpottingReport>& parts) {
     r.latency_hold_s.insert(r.latency_hold_s.end(), p.latency_hold_s.begin(), p.latency_hold_s.end());
     r.target_error_m.insert(r.target_error_m.end(), p.target_error_m.begin(), p.target_error_m.end());
     r.ray_error_deg.insert(r.ray_error_deg.end(), p.ray_error_deg.begin(), p.ray_error_deg.end());
+    r.non_gesture_s += p.non_gesture_s;
   }
   finish(r);
   return r;
@@ -405,6 +415,7 @@ void finish(SpottingReport& r) {
   r.median_target_error_m = median(r.target_error_m);
   r.median_ray_error_deg = median(r.ray_error_deg);
   r.max_target_error_m = r.target_error_m.empty() ? std::nan("") : *std::max_element(r.target_error_m.begin(), r.target_error_m.end());
+  r.false_per_hour = r.non_gesture_s > 0 ? r.false_positive / (r.non_gesture_s / 3600.0) : std::nan("");
 }
 
 nlohmann::json to_json(const SpottingReport& r) {
@@ -423,6 +434,8 @@ nlohmann::json to_json(const SpottingReport& r) {
           {"median_target_error_m", num(r.median_target_error_m)},
           {"max_target_error_m", num(r.max_target_error_m)},
           {"median_ray_error_deg", num(r.median_ray_error_deg)},
+          {"non_gesture_hours", r.non_gesture_s / 3600.0},
+          {"false_per_hour", num(r.false_per_hour)},
           {"latency_s", r.latency_s},
           {"ray_error_deg", r.ray_error_deg},
           {"target_error_m", r.target_error_m}};

@@ -78,6 +78,7 @@ struct SpotterOptions {
   double max_target = 4.0;     // m: the ray must meet a surface within this of the shoulder (0: any ray, none needed)
   bool other_arm_free = true;  // the other arm not held out as well (carrying, a stretch, hands on the knees)
   double min_confidence = 0.0; // events less sure than this are dropped (the operating point: recall against false alarms)
+  double confirm = 0.0;        // s: pointing must stay held this long after `hold` or it is dropped (a confirmation; 0: none)
   std::string point_label = "point";
   std::vector<Surface> surfaces{Surface{}};  // the ray's target: the nearest hit
 };
@@ -157,6 +158,7 @@ class Spotter {
   int best_side_ = -1;
   std::optional<SpottedEvent> aiming_;  // pointing decided, its ray still gathered over the hold
   int aiming_side_ = -1;
+  std::int64_t aiming_hold_ns_ = 0;  // when the hold being aimed began
   bool have_hand_[2] = {false, false};
   std::uint32_t person_ = 0;
   Eigen::Vector3d across_ = Eigen::Vector3d::UnitX();  // left -> right shoulder, horizontal
@@ -184,6 +186,9 @@ struct SpottingReport {
   std::vector<double> ray_error_deg;    // matched events with both rays: angle between the directions
   double median_latency_s = 0, median_latency_hold_s = 0, median_target_error_m = 0, max_target_error_m = 0;
   double median_ray_error_deg = 0;
+  // False alarms per hour of the stream outside the label's true gestures
+  // (non_gesture_s: set by whoever made the stream; 0: not known, then NaN).
+  double non_gesture_s = 0, false_per_hour = 0;
 };
 
 // Matches events of `label` to truth gestures of that label: an event within
