@@ -227,8 +227,10 @@ std::function<double(double)> gesture(double from, double angle) {
 
 TEST(Spotting, PointingLandsWithinReachAndLeavesTheOtherArmFree) {
   const auto c = always_point();
-  const SpotterOptions defaults;
-  // 70 degrees up from hanging from 1.45 m: the floor 4.2 m from the shoulder, beyond the default 4 m.
+  EXPECT_EQ(SpotterOptions{}.max_target, 0.0);  // off unless the surfaces are known (gesture spot on recordings)
+  SpotterOptions defaults;
+  defaults.max_target = 4.0;  // the cell's (sim_spotter_options(), the gesture component)
+  // 70 degrees up from hanging from 1.45 m: the floor 4.2 m from the shoulder, beyond 4 m.
   EXPECT_TRUE(spot(c, arm_stream(gesture(2.0, 70), 8), defaults).empty());
   // 55 degrees: 2.5 m away, an event with its target.
   const auto near = spot(c, arm_stream(gesture(2.0, 55), 8), defaults);

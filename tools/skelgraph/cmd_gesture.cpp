@@ -587,7 +587,8 @@ void add_model_options(CLI::App* c, GestureOptions& o) {
 }
 
 // The spotter's settings, the same on `gesture spot` and `gesture sim`.
-void add_spotter_options(CLI::App* c, GestureOptions& o) {
+// Returns --max-target, whose default differs between spot and sim.
+CLI::Option* add_spotter_options(CLI::App* c, GestureOptions& o) {
   c->add_option("--hold", o.spot.hold, "s an extended arm is held before pointing is tried (default 0.25)")->check(CLI::Range(0.0, 5.0));
   c->add_option("--aim", o.spot.aim,
                 "s of the hold the pointing ray is averaged over, at most: the event goes out when the arm moves again or then "
@@ -597,8 +598,9 @@ void add_spotter_options(CLI::App* c, GestureOptions& o) {
   c->add_option("--min-raise", o.spot.min_raise,
                 "degrees from hanging straight down an extended arm must be raised to count as a pointing hold (default 35)")
       ->check(CLI::Range(0.0, 180.0));
-  c->add_option("--max-target", o.spot.max_target,
-                "m: pointing must land on a surface within this of the shoulder (default 4; 0: any ray, none needed)")
+  auto* max_target = c->add_option("--max-target", o.spot.max_target,
+                "m: pointing must land on a surface within this of the shoulder (0: any ray, none needed; default 4 in "
+                "gesture sim, the simulated cell's floor; 0 in gesture spot: where a recording's surfaces are is not known)")
       ->check(CLI::Range(0.0, 100.0));
   c->add_option("--other-arm-free", o.spot.other_arm_free,
                 "pointing needs the other arm not held out as well (default true)");
@@ -608,6 +610,7 @@ void add_spotter_options(CLI::App* c, GestureOptions& o) {
   c->add_option("--min-confidence", o.spot.min_confidence,
                 "events less sure than this (1 - exp(-margin) over the next class) are dropped (default 0)")
       ->check(CLI::Range(0.0, 1.0));
+  return max_target;
 }
 
 }  // namespace
@@ -677,9 +680,12 @@ void add_gesture_command(CLI::App& app, GlobalOptions&, Action& run) {
                  "training sessions of each of them whose false alarms the model is trained again against (default 8; 0: none)")
       ->check(CLI::Range(0, 200));
   sm->add_option("--out", o->out, "write the trained classifier (JSON), e.g. for the gesture component");
-  add_spotter_options(sm, *o);
+  auto* sim_max_target = add_spotter_options(sm, *o);
   sm->add_option("--window", o->spot.window, "s over which hand speed is measured (default 0.25)")->check(CLI::Range(0.03, 2.0));
-  sm->callback([o, &run] { run = [o] { return gesture_sim(*o); }; });
+  sm->callback([o, sim_max_target, &run] {
+    if (sim_max_target->count() == 0) o->spot.max_target = sim_spotter_options().max_target;  // the cell's floor
+    run = [o] { return gesture_sim(*o); };
+  });
 
   auto* c = g->add_subcommand("classify", "Classify recordings with a trained classifier");
   add_common(c, *o, false);

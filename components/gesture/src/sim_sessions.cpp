@@ -229,6 +229,12 @@ std::vector<SimSession> held_out_sessions(int sessions, std::uint64_t seed, cons
   return out;
 }
 
+SpotterOptions sim_spotter_options() {
+  SpotterOptions o;
+  o.max_target = 4.0;
+  return o;
+}
+
 const std::vector<std::string>& quiet_scenarios() {
   static const std::vector<std::string> names{"walk", "360", "hide", "box", "occ", "sit", "arms", "work"};
   return names;

@@ -30,6 +30,11 @@ struct SimSession {
   std::vector<Hold> holds;
 };
 
+// The spotter in the simulated cell: pointing lands on its floor within 4 m
+// of the shoulder (max_target; where the surfaces of a recording are is not
+// known, so `gesture spot` leaves it off).
+SpotterOptions sim_spotter_options();
+
 // The pointing arm's joint offsets (PointingCorrection::shoulder, hand): the
 // median, per body axis, of where the fused shoulder and hand are against the
 // true ones over the sessions' holds.
@@ -76,7 +81,7 @@ struct QuietReport {
   std::map<std::string, int> events;    // per class, every scenario
   double per_hour(const std::string& label) const;
 };
-QuietReport spot_quiet(const Classifier& model, const std::vector<SimSession>& sessions, const SpotterOptions& options = {});
+QuietReport spot_quiet(const Classifier& model, const std::vector<SimSession>& sessions, const SpotterOptions& options = sim_spotter_options());
 
 // Labelled clips cut from sessions: each true gesture (action point, wave or
 // stretch; from `pad` s before to `pad` s after) and one rest clip per rest
@@ -102,7 +107,7 @@ struct SessionSpotting {
   SpottingReport report;
 };
 std::vector<SessionSpotting> spot_sessions(const Classifier& model, const std::vector<SimSession>& sessions,
-                                           const SpotterOptions& options = {});
+                                           const SpotterOptions& options = sim_spotter_options());
 
 // The default training: pointing sessions, and sessions of each quiet
 // scenario whose false alarms it is trained again against (the best
@@ -116,7 +121,7 @@ constexpr int kTrainQuietSessions = 8;
 // sessions of each quiet scenario is added as "other" and it is trained again.
 // The pointing correction is learnt by spotting the training sessions with `spot`.
 Classifier train_on_sim(int sessions, std::uint64_t seed, const ClassifierOptions& options, std::size_t* clips = nullptr,
-                        const std::function<void(int done, int total)>& progress = {}, const SpotterOptions& spot = {},
+                        const std::function<void(int done, int total)>& progress = {}, const SpotterOptions& spot = sim_spotter_options(),
                         int quiet_per_scenario = kTrainQuietSessions);
 
 }  // namespace skelgraph::gesture

@@ -75,7 +75,8 @@ struct SpotterOptions {
   double min_length = 0.4;     // s: shorter segments are ignored
   double max_length = 10.0;    // s: longer ones are cut (classified and reopened)
   // Pointing, told from work that holds an arm out (docs/experiments/2026-12-04-quiet-gestures.md):
-  double max_target = 4.0;     // m: the ray must meet a surface within this of the shoulder (0: any ray, none needed)
+  double max_target = 0.0;     // m: the ray must meet a surface within this of the shoulder (0: any ray, none needed;
+                               // a cell whose surfaces are known uses 4: sim_spotter_options(), the `gesture` component)
   bool other_arm_free = true;  // the other arm not held out as well (carrying, a stretch, hands on the knees)
   double min_confidence = 0.0; // events less sure than this are dropped (the operating point: recall against false alarms)
   double confirm = 0.0;        // s: pointing must stay held this long after `hold` or it is dropped (a confirmation; 0: none)
