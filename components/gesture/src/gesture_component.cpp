@@ -73,8 +73,27 @@ runtime::ComponentInfo GestureComponent::describe() {
   return info;
 }
 
+namespace {
+SpotterOptions spotter_options(const runtime::Params& params) {
+  SpotterOptions o;
+  o.point_label = params.get<std::string>("point_label");
+  o.hold = params.get<double>("hold_s");
+  o.aim = params.get<double>("aim_s");
+  o.still_speed = params.get<double>("still_speed");
+  o.min_raise = params.get<double>("min_raise_deg");
+  o.max_target = params.get<double>("max_target_m");
+  o.other_arm_free = params.get<bool>("other_arm_free");
+  o.confirm = params.get<double>("confirm_s");
+  o.min_confidence = params.get<double>("min_confidence");
+  o.surfaces.clear();
+  for (const auto& s : runtime::rejoin_named_items(params.get<std::vector<std::string>>("surfaces"))) o.surfaces.push_back(parse_surface(s));
+  return o;
+}
+}  // namespace
+
 GestureComponent::GestureComponent(runtime::Context& ctx, const runtime::Params& params)
     : Component(ctx),
+      options_(spotter_options(params)),
       classifier_(load_model(params.get<std::string>("model"), ctx.name())),
       person_timeout_ns_(static_cast<std::int64_t>(params.get<double>("person_timeout_ms") * 1e6)),
       event_pub_(ctx, runtime::topics::kGestureEvent),
@@ -87,18 +106,6 @@ GestureComponent::GestureComponent(runtime::Context& ctx, const runtime::Params&
             const auto it = people_.find({last.sensor_id().to_string(), last.person_id()});
             if (it != people_.end()) forget(it);
           }) {
-  options_.point_label = params.get<std::string>("point_label");
-  options_.hold = params.get<double>("hold_s");
-  options_.aim = params.get<double>("aim_s");
-  options_.still_speed = params.get<double>("still_speed");
-  options_.min_raise = params.get<double>("min_raise_deg");
-  options_.max_target = params.get<double>("max_target_m");
-  options_.other_arm_free = params.get<bool>("other_arm_free");
-  options_.confirm = params.get<double>("confirm_s");
-  options_.min_confidence = params.get<double>("min_confidence");
-  options_.surfaces.clear();
-  const auto surfaces = runtime::rejoin_named_items(params.get<std::vector<std::string>>("surfaces"));
-  for (const auto& s : surfaces) options_.surfaces.push_back(parse_surface(s));
   const auto& labels = classifier_.labels();
   if (std::find(labels.begin(), labels.end(), options_.point_label) == labels.end())
     spdlog::warn("{}: the classifier has no class '{}': no pointing rays will be given", ctx_.name(), options_.point_label);

@@ -44,8 +44,8 @@ class GestureComponent final : public runtime::Component {
   // The person left: their state instance is disposed.
   People::iterator forget(People::iterator it);
 
+  SpotterOptions options_;  // first: bad parameters are refused before a model is trained
   Classifier classifier_;
-  SpotterOptions options_;
   std::int64_t person_timeout_ns_;
   People people_;
   std::map<std::string, std::uint64_t> events_by_label_;
