@@ -212,6 +212,21 @@ for s in d["sensors"]:
 assert rc == (0 if all(s["verdict"].startswith("good") for s in d["sensors"]) and not d["failed"] else 1), rc
 print("hand at the tool:", [(s["sensor"], round(s["error_deg"], 1), round(s["error_cm"], 1), s["verdict"][:4]) for s in d["sensors"]])
 PY
+# With the sensors' poses relative to each other (--cell): one fit for the whole cell, every sensor through it.
+"$S" calib robot --hand "$WORK/hand.mcap" --base 0,0,1.5,180 --cell "$WORK/ring4.yaml" --truth "$WORK/ring4.yaml" --json \
+  >"$WORK/hand_cell.json" 2>/dev/null || true
+python3 - "$WORK/hand.json" "$WORK/hand_cell.json" <<'PY' || fail "calib robot --hand --cell: $(head -c 1500 "$WORK/hand_cell.json")"
+import json, sys
+alone, cell = (json.load(open(f)) for f in sys.argv[1:])
+assert sorted(s["sensor"] for s in cell["sensors"]) == ["sensor1", "sensor2", "sensor3", "sensor4"] and not cell["failed"], cell
+assert len({(s["places"], s["places_agreeing"], s["rms_residual_cm"]) for s in cell["sensors"]}) == 1, cell   # one fit
+assert cell["sensors"][0]["places"] >= max(s["places"] for s in alone["sensors"]), (cell, alone)              # every sensor's holds
+print("hand at the tool, whole cell: worst %.1f deg, %.1f cm (each sensor alone: %.1f deg, %.1f cm)"
+      % (cell["worst_error_deg"], cell["worst_error_cm"], alone["worst_error_deg"], alone["worst_error_cm"]))
+PY
+head -16 "$WORK/ring4.yaml" >"$WORK/ring2.yaml"   # sensor1 and sensor2 only
+"$S" calib robot --hand "$WORK/hand.mcap" --cell "$WORK/ring2.yaml" --json >"$WORK/hand_cell2.json" 2>/dev/null || true
+json_check "$WORK/hand_cell2.json" 'sorted(s["sensor"] for s in d["sensors"]) == ["sensor1", "sensor2"] and sorted(f.split(":")[0] for f in d["failed"]) == ["sensor3", "sensor4"]'
 "$S" calib robot --hand "$WORK/robot_cal.yaml" 2>"$WORK/bad.err" && fail "a YAML file was read as a recording"
 grep -q "robot_cal.yaml" "$WORK/bad.err" || fail "not a recording: $(cat "$WORK/bad.err")"
 ok "hand at the tool: holds found at the reaches, the verdict follows the residuals"

@@ -899,7 +899,7 @@ struct RobotOptions {
   std::string base = "0,0,1.5,180";
   std::string size = "9x6";
   double square_m = 0.08, hold_s = 1.0, inlier_cm = 8.0;
-  std::string truth, out;
+  std::string truth, out, cell;
   bool json = false;
 };
 
@@ -974,6 +974,7 @@ int calib_robot(const RobotOptions& o) {
   };
   std::vector<Result> results;
   std::vector<std::string> failed;  // sensors without a fit, with the reason
+  std::vector<std::string> cell_sensors;  // --cell: the sensors fitted together
   if (hand_mode) {
     // Either hand by default: a tracker that sees the person's back swaps left and right,
     // and the hand not at the tool is an outlier RANSAC leaves out.
@@ -983,14 +984,41 @@ int calib_robot(const RobotOptions& o) {
     const auto in = read_hand_input(o.hand_recording, joints);
     calib::HoldOptions ho;
     ho.hold_s = o.hold_s;
+    // --cell: the sensors already calibrated to each other; every sensor's
+    // holds in that frame, one fit for the whole cell (the sensors' hand
+    // errors differ by view and partly cancel).
+    std::map<std::string, Eigen::Isometry3d> cell;
+    if (!o.cell.empty()) cell = prior_poses(o.cell);
+    std::map<std::string, std::vector<calib::Hold>> by_sensor;
     for (const auto& [sensor, people] : in.hands) {
-      std::vector<calib::Hold> holds;
+      auto& holds = by_sensor[sensor];
       for (const auto& [id, pts] : people) {
         const auto h = calib::find_holds(in.tool, pts, ho);
         holds.insert(holds.end(), h.begin(), h.end());
       }
       // The tool's positions are in the world the robot reports in: to its base.
       for (auto& h : holds) h.tool = world_from_base.inverse() * h.tool;
+    }
+    if (!cell.empty()) {
+      std::vector<calib::Hold> pooled;
+      std::vector<std::string> in_cell;
+      for (auto& [sensor, holds] : by_sensor) {
+        const auto c = cell.find(sensor);
+        if (c == cell.end()) {
+          failed.push_back(sensor + ": not in " + o.cell);
+          continue;
+        }
+        for (auto h : holds) {
+          h.hand = c->second * h.hand;
+          pooled.push_back(h);
+        }
+        in_cell.push_back(sensor);
+      }
+      by_sensor.clear();
+      by_sensor["cell"] = pooled;
+      cell_sensors = in_cell;
+    }
+    for (const auto& [sensor, holds] : by_sensor) {
       // The places the tool held still at (both hands may pair with one).
       const auto places = [&](const std::vector<std::size_t>& which) {
         std::vector<Eigen::Vector3d> out;
@@ -1007,7 +1035,16 @@ int calib_robot(const RobotOptions& o) {
         for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
         r.places = places(all);
         r.places_agreeing = places(r.fit.ransac.inliers);
-        results.push_back(std::move(r));
+        if (sensor == "cell" && !cell.empty()) {  // base_from_cell: each sensor through its pose in the cell
+          for (const auto& s : cell_sensors) {
+            Result rs = r;
+            rs.sensor = s;
+            rs.fit.base_from_sensor = r.fit.base_from_sensor * cell.at(s);
+            results.push_back(std::move(rs));
+          }
+        } else {
+          results.push_back(std::move(r));
+        }
       } catch (const calib::CalibError& e) {
         failed.push_back(sensor + ": " + e.what());
       }
@@ -1261,6 +1298,10 @@ void add_calib_command(CLI::App& app, GlobalOptions&, Action& run) {
   rb->add_option("--which-hand", ro->hand, "the hand held at the tool: right, left or either (default either: a sensor "
                                            "behind the person reports the hands swapped)")
       ->check(CLI::IsMember({"right", "left", "either"}));
+  rb->add_option("--cell", ro->cell,
+                 "hand at the tool: a calibration file with the sensors' poses relative to each other (e.g. from calib "
+                 "skeleton): every sensor's holds in that frame, one fit for the whole cell")
+      ->check(CLI::ExistingFile);
   rb->add_option("--hold", ro->hold_s, "hand at the tool: both still this long make a pair, s (default 1)")->check(kPositive);
   rb->add_option("--inlier-cm", ro->inlier_cm, "hand at the tool: a pair agrees within this under a good pose (default 8)")->check(kPositive);
   rb->add_option("--base", ro->base, "where the robot's base stands in the world: x,y,z (m; y up) and yaw (deg), as "
