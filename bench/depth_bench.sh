@@ -14,9 +14,10 @@
 set -euo pipefail
 build=${1:?usage: depth_bench.sh BUILD_DIR [SECONDS]}
 seconds=${2:-30}
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-unshare -n bash -c '
+"$root/tests/netns-lo.sh" bash -c '
   set -e
   ip link set lo up
   export SKELGRAPH_DOMAIN=78

@@ -6,7 +6,7 @@
 # event's floor target against where the true shoulder -> hand ray of the
 # same arm met the floor while that arm was held still near the event's
 # stamp. JSON on stdout: per event the error, and the median. Needs root for
-# `unshare -n`. NOISE_SCALE (default 1) scales the simulated trackers' random
+# tests/netns-lo.sh. NOISE_SCALE (default 1) scales the simulated trackers' random
 # errors (the sim's noise_scale; 0 leaves the skeleton convention's offsets,
 # the lag and the geometry): how far the targets are off without that noise.
 # SCENARIO (default point) runs another simulator scenario instead; in one
@@ -30,7 +30,7 @@ if [[ "$noise" != 1 || "$scenario" != point ]]; then
   grep -q "noise_scale: $noise" "$launch" && grep -q "scenario: $scenario" "$launch" ||
     { echo "gesture_live.sh: could not set noise_scale and scenario in $launch" >&2; exit 2; }
 fi
-unshare -n bash -c '
+"$root/tests/netns-lo.sh" bash -c '
   set -e
   ip link set lo up
   cd "$1"

@@ -35,7 +35,7 @@ YAML
     done
   done
 done
-unshare -n bash -s "$build" "$seconds" "$work" "${runs[@]}" <<'INNER'
+"$root/tests/netns-lo.sh" bash -s "$build" "$seconds" "$work" "${runs[@]}" <<'INNER'
 set -euo pipefail
 build=$1 seconds=$2 work=$3
 shift 3

@@ -12,7 +12,7 @@ seconds=${2:-60}
 root=$(cd "$(dirname "$0")/.." && pwd)
 work=$(mktemp -d "$build/bench/record.XXXXXX")
 trap 'rm -rf "$work"' EXIT
-unshare -n -- bash -s "$build" "$seconds" "$root" "$work" <<'INNER'
+"$root/tests/netns-lo.sh" bash -s "$build" "$seconds" "$root" "$work" <<'INNER'
 set -euo pipefail
 build=$1 seconds=$2 root=$3 work=$4
 ip link set lo up

@@ -24,7 +24,7 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 mkdir -p "$build/bench"
 work=$(mktemp -d "$build/bench/soak.XXXXXX")
 trap 'rm -rf "$work"' EXIT
-unshare -n -- bash -s "$build" "$work" "$sensors" "$places" "$repeats" "$rate" "$root" <<'INNER'
+"$root/tests/netns-lo.sh" bash -s "$build" "$work" "$sensors" "$places" "$repeats" "$rate" "$root" <<'INNER'
 set -euo pipefail
 build=$1 work=$2 sensors=$3 places=$4 repeats=$5 rate=$6 root=$7
 ip link set lo up

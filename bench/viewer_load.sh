@@ -15,7 +15,7 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 cd "$root"
-unshare -n bash -s "$build" "$seconds" "$work" <<'INNER'
+"$root/tests/netns-lo.sh" bash -s "$build" "$seconds" "$work" <<'INNER'
 set -euo pipefail
 build=$1 seconds=$2 work=$3
 ip link set lo up
