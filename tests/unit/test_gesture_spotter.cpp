@@ -6,10 +6,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <stdexcept>
 #include <functional>
 #include <map>
 #include <set>
 
+#include "skelgraph/gesture/builtin_models.hpp"
 #include "skelgraph/gesture/sim_sessions.hpp"
 #include "skelgraph/gesture/spotter.hpp"
 #include "skelgraph/sim/tracker.hpp"
@@ -334,4 +337,35 @@ TEST(Spotting, APersonLostAndFoundSettlesAgain) {
   const auto short_gap = spot(c, arm_stream(gesture(1.6, 70), 8, 1.0, 1.2));
   ASSERT_EQ(short_gap.size(), 1u);
   EXPECT_EQ(short_gap[0].end_ns, plain[0].end_ns);
+}
+
+// The built-in model the launch files' `model: sim` loads, trained by the
+// build: a pointing classifier that finds pointing in sessions it never saw,
+// and a clear error naming the file when it is missing.
+TEST(BuiltinModel, TheBuildsSimModelSpotsPointing) {
+  ASSERT_TRUE(is_builtin_model("sim"));
+  EXPECT_FALSE(is_builtin_model("sim.json"));
+  const auto model = load_builtin_model("sim");
+  const auto& labels = model.labels();
+  EXPECT_NE(std::find(labels.begin(), labels.end(), "point"), labels.end());
+  const auto spotted = spot_sessions(model, held_out_sessions(1, 77));
+  ASSERT_EQ(spotted.size(), 1u);
+  EXPECT_EQ(spotted[0].report.truth, 6);
+  EXPECT_GE(spotted[0].report.recall, 0.8);
+}
+
+TEST(BuiltinModel, AMissingModelNamesItsFileAndTheBuildTarget) {
+  const std::string before = builtin_model_dir().string();
+  ::setenv("SKELGRAPH_MODEL_DIR", "/nonexistent/models", 1);
+  try {
+    load_builtin_model("sim");
+    ADD_FAILURE() << "no error for a missing model";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("/nonexistent/models/sim.json"), std::string::npos) << what;
+    EXPECT_NE(what.find("gesture_models"), std::string::npos) << what;
+  }
+  ::unsetenv("SKELGRAPH_MODEL_DIR");
+  EXPECT_EQ(builtin_model_dir().string(), before);
+  EXPECT_THROW(load_builtin_model("stop"), std::invalid_argument);
 }

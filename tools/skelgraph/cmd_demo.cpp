@@ -26,6 +26,7 @@
 #include "eval_sim.hpp"
 #include "report.hpp"
 #include "skelgraph/eval/safety.hpp"
+#include "skelgraph/gesture/builtin_models.hpp"
 #include "skelgraph/gesture/sim_sessions.hpp"
 #include "run_graph.hpp"
 #include "skelgraph/runtime/launch_file.hpp"
@@ -40,12 +41,12 @@ struct Section {
   std::string html;
 };
 
-// Pointing on simulated sessions: train as `gesture sim` does, spot in 4
-// held-out ones and score against the truth; and the false alarms in a
+// Pointing on simulated sessions: the built-in model the live graph uses
+// (trained by the build as `gesture sim` trains), spotting in 4 held-out ones and score against the truth; and the false alarms in a
 // session of each scenario where nobody gestures.
 Section pointing_section() {
   using namespace skelgraph::gesture;
-  const auto model = train_on_sim(kTrainSessions, 1, sim_classifier_options());
+  const auto model = load_builtin_model("sim");
   const auto sessions = held_out_sessions(4, 1);
   std::vector<SpottingReport> reports;
   std::string rows;

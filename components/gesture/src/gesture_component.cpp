@@ -5,7 +5,7 @@
 
 #include <spdlog/spdlog.h>
 
-#include "skelgraph/gesture/sim_sessions.hpp"
+#include "skelgraph/gesture/builtin_models.hpp"
 #include "skelgraph/runtime/topics.hpp"
 #include "skelgraph/skeleton/skeleton_msg.hpp"
 
@@ -22,15 +22,9 @@ const runtime::TopicDef<msg::Skeleton>& input_topic(const std::string& name) {
 Classifier load_model(const std::string& path, const std::string& who) {
   if (path.empty())
     throw std::invalid_argument("model: no classifier given (a file from `skelgraph gesture train` or `gesture sim --out`, or 'sim')");
-  if (path == "sim") {
-    spdlog::info("{}: training the pointing classifier on {} simulated sessions and false alarms in {} of each quiet scenario ...",
-                 who, kTrainSessions, kTrainQuietSessions);
-    std::size_t clips = 0;
-    auto c = train_on_sim(kTrainSessions, 1, sim_classifier_options(), &clips);
-    spdlog::info("{}: trained on {} clips", who, clips);
-    return c;
-  }
-  auto c = Classifier::load(path);
+  const bool builtin = is_builtin_model(path);
+  auto c = builtin ? load_builtin_model(path) : Classifier::load(path);
+  if (builtin) spdlog::info("{}: built-in model '{}' ({})", who, path, builtin_model_path(path).string());
   if (needs_wrists(c.feature_set()))
     throw std::invalid_argument("model: " + path + " uses the '" + feature_set_name(c.feature_set()) +
                                 "' features, which need wrist joints; the skeleton topics carry none (train with thesis8, extended or body)");
@@ -52,7 +46,7 @@ runtime::ComponentInfo GestureComponent::describe() {
                               "Spots gestures (pointing first) in a skeleton stream; publishes skelgraph/gesture/event with "
                               "the pointing ray and its target, and each person's state on skelgraph/gesture/state",
                               {}};
-  info.params.add_string("model", "", "classifier file (skelgraph gesture train / gesture sim --out), or 'sim': train on simulated sessions at start (~2 s)")
+  info.params.add_string("model", "", "classifier file (skelgraph gesture train / gesture sim --out), or 'sim': the built-in pointing model (trained on simulated sessions by the build)")
       .add_string("input", "fused", "skeleton stream to watch", {"fused", "raw", "truth"})
       .add_string("point_label", "point", "the classifier's label for pointing")
       .add_string_list("surfaces", {"floor:0,0,0"},
