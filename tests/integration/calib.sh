@@ -230,3 +230,31 @@ json_check "$WORK/hand_cell2.json" 'sorted(s["sensor"] for s in d["sensors"]) ==
 "$S" calib robot --hand "$WORK/robot_cal.yaml" 2>"$WORK/bad.err" && fail "a YAML file was read as a recording"
 grep -q "robot_cal.yaml" "$WORK/bad.err" || fail "not a recording: $(cat "$WORK/bad.err")"
 ok "hand at the tool: holds found at the reaches, the verdict follows the residuals"
+
+# A real KinectMultiTrack recording with one line whose time goes backwards:
+# in a batch it is reported (file:line) and the good one still calibrated (exit
+# 2); with --on-error skip the line is skipped, said, and the file calibrates.
+KMT=${SKELGRAPH_DATA_DIR:-$SKELGRAPH_SOURCE_DIR/../shared/data}/kinect-multitrack/Experiments_1_2_3_6
+[ -d "$KMT" ] || fail "$KMT is missing: tests read ../shared/data (or SKELGRAPH_DATA_DIR)"
+good="$KMT/Study_12_Kinect_2_Time_5_01_13_PM.csv"
+python3 - "$good" "$WORK/back.csv" <<'PY'
+import sys
+lines = open(sys.argv[1]).read().split("\n")
+f = lines[50].split(", ")
+f[3] = str(int(f[3]) - 10_000_000)  # Tracker_Time one second back
+lines[50] = ", ".join(f)
+open(sys.argv[2], "w").write("\n".join(lines))
+PY
+rc=0
+"$S" calib skeleton --format multitrack "$WORK/back.csv" "$good" --ref kinect_138_251_213_82 --prior shared --json \
+  >"$WORK/back.json" 2>"$WORK/back.err" || rc=$?
+[ "$rc" -eq 2 ] || fail "calib skeleton with a bad input exited $rc, expected 2: $(cat "$WORK/back.err")"
+grep -q "back.csv:51: time goes backwards" "$WORK/back.err" || fail "the bad line is not named: $(cat "$WORK/back.err")"
+json_check "$WORK/back.json" 'len(d) == 2 and "back.csv:51" in d[0]["error"] and d[1]["verdict"].startswith("calibrated")'
+rc=0
+"$S" calib skeleton --format multitrack "$WORK/back.csv" --on-error skip --ref kinect_138_251_213_82 --prior shared --json \
+  >"$WORK/skip.json" 2>"$WORK/skip.err" || rc=$?
+[ "$rc" -eq 0 ] || fail "calib skeleton --on-error skip exited $rc: $(cat "$WORK/skip.err")"
+grep -q "back.csv: 1 bad line of .* skipped" "$WORK/skip.err" || fail "the skipped line is not said: $(cat "$WORK/skip.err")"
+json_check "$WORK/skip.json" 'd[0]["verdict"].startswith("calibrated")'
+ok "calib skeleton: a bad input in a batch is named and the others calibrated (exit 2); --on-error skip reads past the bad line"

@@ -91,6 +91,43 @@ echo '{"format": "skelgraph-gesture-classifier", "version": 1}' >"$WORK/bad.json
 grep -q "missing field" "$WORK/bad.err" || fail "malformed model error: $(cat "$WORK/bad.err")"
 ok "bad class file and malformed model: clear errors"
 
+# Bad files in a batch: each reported with file:line, the others still processed, exit 2 at the end.
+mkdir -p "$WORK/batch"
+point=$(ls "$KG"/*p976_*Point* | head -1)
+ln -s "$point" "$WORK/batch/a_point.csv"
+head -1 "$point" >"$WORK/batch/b_header_only.csv"
+{ head -1 "$point"; printf '12\x1b[2J,3\n'; } >"$WORK/batch/c_control_bytes.csv"
+{ head -1 "$point"; sed -n 2,4p "$point" | sed 's/^[^,]*,/x\x07y,/'; sed -n '5,$p' "$point"; } >"$WORK/batch/d_bad_lines.csv"
+rc=0
+"$S" gesture classify --model "$WORK/model.json" --json "$WORK/batch" >"$WORK/batch.json" 2>"$WORK/batch.err" || rc=$?
+[ "$rc" -eq 2 ] || fail "classify a batch with bad files exited $rc, expected 2: $(cat "$WORK/batch.err")"
+json_check "$WORK/batch.json" 'len(d) == 4 and d[0]["label"] == "point" and all("error" in e for e in d[1:]) and "label" not in d[1]'
+grep -q "b_header_only.csv:1: no data rows" "$WORK/batch.err" || fail "a header-only clip: $(cat "$WORK/batch.err")"
+grep -q "c_control_bytes.csv:2: expected 63 fields" "$WORK/batch.err" || fail "a short line: $(cat "$WORK/batch.err")"
+grep -q "d_bad_lines.csv:2: column 'Timestamp' expects a number, got 'x.x07y'" "$WORK/batch.err" || fail "a bad number: $(cat "$WORK/batch.err")"
+grep -q "3 of 4 inputs were bad" "$WORK/batch.err" || fail "no summary of the bad inputs: $(cat "$WORK/batch.err")"
+LC_ALL=C grep -q $'[\x01-\x08\x0b-\x1f\x7f]' "$WORK/batch.err" "$WORK/batch.json" && fail "raw control bytes printed: $(cat -v "$WORK/batch.err")"
+# --on-error skip: the file with bad lines is read without them (and says so); the header-only clip stays bad.
+rc=0
+"$S" gesture classify --model "$WORK/model.json" --json --on-error skip "$WORK/batch/d_bad_lines.csv" "$WORK/batch/b_header_only.csv" \
+  >"$WORK/skip.json" 2>"$WORK/skip.err" || rc=$?
+[ "$rc" -eq 2 ] || fail "classify --on-error skip exited $rc, expected 2 (a header-only clip): $(cat "$WORK/skip.err")"
+json_check "$WORK/skip.json" 'len(d) == 2 and d[0]["label"] == "point" and "error" in d[1]'
+grep -q "d_bad_lines.csv: 3 bad lines of .* skipped" "$WORK/skip.err" || fail "skipped lines not reported: $(cat "$WORK/skip.err")"
+# Training goes on without the bad files (exit 2), and with --on-error skip uses the file with bad lines.
+mkdir -p "$WORK/train_bad" && cp -s "$WORK/train"/*.csv "$WORK/train_bad/" && cp "$WORK/batch/b_header_only.csv" "$WORK/train_bad/"
+rc=0
+"$S" gesture train "$WORK/train_bad" --states 3 --json >"$WORK/train_bad.json" 2>"$WORK/train_bad.err" || rc=$?
+[ "$rc" -eq 2 ] || fail "train with a bad file exited $rc, expected 2: $(cat "$WORK/train_bad.err")"
+json_check "$WORK/train_bad.json" 'd["clips"] == 144'
+grep -q "b_header_only.csv:1" "$WORK/train_bad.err" || fail "train: the bad file is not named: $(cat "$WORK/train_bad.err")"
+# play-data --info: the same rule.
+rc=0
+"$S" play-data kinder-gator --info "$point" "$WORK/batch/b_header_only.csv" >"$WORK/info.json" 2>"$WORK/info.err" || rc=$?
+[ "$rc" -eq 2 ] || fail "play-data --info with a bad file exited $rc, expected 2"
+json_check "$WORK/info.json" 'len(d) == 2 and d[0]["frames"] > 10 and "no data rows" in d[1]["error"]'
+ok "bad files in a batch: named with file:line, control bytes escaped, the others processed, exit 2"
+
 # Continuous streams: three subjects, each spotted by a model trained on the other two.
 mkdir -p "$WORK/three"
 for f in "$KG"/*p565_* "$KG"/*p604_* "$KG"/*p734_*; do ln -s "$f" "$WORK/three/"; done

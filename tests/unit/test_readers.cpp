@@ -109,6 +109,12 @@ TEST(Readers, BadLinesNameFileLineAndExpectation) {
             std::string::npos);
   EXPECT_NE(error("Time,A\n", "kg_f.csv").find("kg_f.csv:1: expected 63 fields"), std::string::npos);
   EXPECT_NE(error("", "kg_g.csv").find("empty file"), std::string::npos);
+  // A header and nothing else is no recording (it used to read as one with no frames).
+  EXPECT_NE(error(kg_header(), "kg_h.csv").find("kg_h.csv:1: no data rows"), std::string::npos);
+  // Input quoted in a message cannot send control bytes to a terminal.
+  const auto escaped = error(kg_header() + kg_row(1, "1\x1b[2J\a", 4), "kg_i.csv");
+  EXPECT_NE(escaped.find("got '1\\x1b[2J\\x07'"), std::string::npos) << escaped;
+  EXPECT_EQ(escaped.find('\x1b'), std::string::npos);
   try {
     read_recording(Format::KinderGator, ::testing::TempDir() + "/nope.csv");
     FAIL();
@@ -132,6 +138,21 @@ TEST(Readers, SkipPolicyKeepsGoodLinesAndReportsBadOnes) {
   ASSERT_EQ(rec.report.problems.size(), 3u);
   EXPECT_NE(rec.report.problems[0].find("kg_skip.csv:3:"), std::string::npos);
   EXPECT_NE(rec.report.problems[2].find("kg_skip.csv:6: time goes backwards"), std::string::npos);
+  EXPECT_NE(skipped_summary(rec).find("kg_skip.csv: 3 bad lines of 7 skipped (first: "), std::string::npos) << skipped_summary(rec);
+  // Every line bad: nothing is left to read, and that is an error naming the last line.
+  const auto all_bad = write_file("kg_all_bad.csv", kg_header() + kg_row(1, "x", 4) + kg_row(2, "y", 5));
+  try {
+    read_recording(Format::KinderGator, all_bad, opt);
+    ADD_FAILURE() << "a file of bad lines read as a recording";
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("kg_all_bad.csv:3: no skeleton frames: every one of the 2 data rows was bad"),
+              std::string::npos) << e.what();
+  }
+}
+
+TEST(Readers, PrintableEscapesControlBytesOnly) {
+  EXPECT_EQ(printable("a\tb\r\n\x01\x7f"), "a\\tb\\r\\n\\x01\\x7f");
+  EXPECT_EQ(printable("Grüße, 東京 ~"), "Grüße, 東京 ~");
 }
 
 TEST(Readers, KinectV2TrackingStatesBecomeConfidence) {

@@ -9,6 +9,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "skelgraph/playback/readers.hpp"
 #include "skelgraph/runtime/dds_config.hpp"
 #include "skelgraph/runtime/launch_file.hpp"
 
@@ -23,6 +24,37 @@ class UsageError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
+
+// A batch of input files in which one bad file does not stop the others: each
+// problem is printed on stderr as it is met ("error: FILE:LINE: what"), the
+// rest is processed, and the command exits 2 (bad input) at the end.
+class BadInputs {
+ public:
+  // Runs f(); a playback::DataError or UsageError from it is reported and counted. True if f() finished.
+  template <class F>
+  bool guard(F&& f) {
+    try {
+      f();
+      return true;
+    } catch (const playback::DataError& e) {
+      add(e.what());
+    } catch (const UsageError& e) {
+      add(e.what());
+    }
+    return false;
+  }
+  void add(const std::string& message);
+  std::size_t count() const { return messages_.size(); }
+  const std::vector<std::string>& messages() const { return messages_; }
+  // `rc` when every input was good; else 2, after "N of M inputs were bad" on stderr.
+  int exit_code(int rc, std::size_t inputs) const;
+
+ private:
+  std::vector<std::string> messages_;
+};
+
+// On stderr, "note: FILE: N bad lines of M skipped (first: ...)" when a read skipped lines.
+void note_skipped(const playback::Recording& recording);
 
 struct GlobalOptions {
   std::optional<int> domain;

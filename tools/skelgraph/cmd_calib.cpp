@@ -36,6 +36,7 @@ struct SkelOptions {
   std::vector<std::string> inputs;
   std::string format;  // empty: MCAP recordings
   std::string ref, other, out, ref_pose, prior;
+  std::string on_error = "stop";  // a bad line in a data-set file: stop (the input is bad) or skip it
   double threshold_m = 0.12, clock_search_ms = 0, robust_scale_m = 0.05;
   bool holdout = false, json = false, best_rigid = false;
   int best_rigid_starts = 1;
@@ -48,12 +49,15 @@ struct Input {
   std::map<std::string, Eigen::Isometry3d> poses;  // world_from_sensor, if recorded
 };
 
-Input read_input(const std::string& path, const std::string& format) {
+Input read_input(const std::string& path, const std::string& format, const std::string& on_error) {
   Input in;
   if (!format.empty()) {
     playback::Recording rec;
+    playback::ReadOptions read;
+    read.on_error = on_error == "skip" ? playback::ReadOptions::OnError::Skip : playback::ReadOptions::OnError::Stop;
     try {
-      rec = playback::read_recording(*playback::format_from_name(format), path);
+      rec = playback::read_recording(*playback::format_from_name(format), path, read);
+      note_skipped(rec);
     } catch (const std::exception& e) {
       throw UsageError(e.what());
     }
@@ -264,7 +268,7 @@ nlohmann::json calibrate_cell_input(const std::string& path, const SkelOptions& 
 
 // One input: fit (on the first half with --holdout), check, and the verdict.
 nlohmann::json calibrate_one(const std::string& path, const SkelOptions& o, std::vector<skeleton::SensorPose>* results) {
-  Input in = read_input(path, o.format);
+  Input in = read_input(path, o.format, o.on_error);
   if (o.prior == "shared") {
     for (const auto& [id, v] : in.by_sensor) in.poses[id] = Eigen::Isometry3d::Identity();
   } else if (!o.prior.empty()) {
@@ -370,17 +374,13 @@ int calib_skeleton(const SkelOptions& o) {
   if (!o.out.empty() && o.inputs.size() != 1) throw UsageError("--out needs exactly one input");
   nlohmann::json all = nlohmann::json::array();
   int failed = 0;
+  BadInputs bad;
   for (const auto& path : o.inputs) {
     std::vector<skeleton::SensorPose> poses;
     nlohmann::json j;
-    try {
-      j = calibrate_one(path, o, &poses);
-    } catch (const UsageError& e) {
-      // One bad input does not stop the others; the exit code says something failed.
-      if (o.inputs.size() == 1) throw;
-      std::fprintf(stderr, "%s\n", e.what());
-      all.push_back({{"input", path}, {"error", e.what()}});
-      ++failed;
+    // One bad input does not stop the others; the exit code says one was bad (2).
+    if (!bad.guard([&] { j = calibrate_one(path, o, &poses); })) {
+      all.push_back({{"input", path}, {"error", bad.messages().back()}});
       continue;
     }
     const bool cell = j.value("mode", "") == "cell";
@@ -462,7 +462,7 @@ int calib_skeleton(const SkelOptions& o) {
     all.push_back(std::move(j));
   }
   if (o.json) std::printf("%s\n", all.dump(2).c_str());
-  return failed > 0 ? 1 : 0;
+  return bad.exit_code(failed > 0 ? 1 : 0, o.inputs.size());
 }
 
 // --- The simulated cell: calibrated from its skeletons, against its truth ---
@@ -1194,6 +1194,10 @@ void add_calib_command(CLI::App& app, GlobalOptions&, Action& run) {
       ->check(CLI::ExistingFile);
   s->add_option("--format", o->format, "the inputs are data-set files of this format")
       ->check(CLI::IsMember(playback::format_names()));
+  s->add_option("--on-error", o->on_error, "a bad line in a data-set file: stop (default: the input is bad, reported, the "
+                                           "others still calibrated, exit 2 at the end) or skip the line")
+      ->check(CLI::IsMember({"stop", "skip"}))
+      ->needs("--format");
   s->add_option("--ref", o->ref, "reference sensor id (its frame is the result's frame)")->required();
   s->add_option("--other", o->other, "the one sensor to calibrate against the reference (default: the only other one, or "
                                      "with several: all of them, jointly)");

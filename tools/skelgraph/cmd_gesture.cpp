@@ -46,6 +46,7 @@ struct GestureOptions {
   std::uint64_t seed = 1;
   int threads = 2;
   bool json = false;
+  std::string on_error = "stop";  // a bad line in an input: stop (the file is bad) or skip it
   // train / classify
   std::string out, model;
   // cv
@@ -95,12 +96,23 @@ ClassifierOptions classifier_options(const GestureOptions& o) {
   return c;
 }
 
-std::vector<Clip> load(const GestureOptions& o, const ClassMap& map, const ClassifierOptions& c) {
+playback::ReadOptions read_options(const GestureOptions& o) {
+  playback::ReadOptions r;
+  r.on_error = o.on_error == "skip" ? playback::ReadOptions::OnError::Skip : playback::ReadOptions::OnError::Stop;
+  return r;
+}
+
+// The clips of the inputs; a bad file is reported in `bad` and left out.
+std::vector<Clip> load(const GestureOptions& o, const ClassMap& map, const ClassifierOptions& c, BadInputs& bad) {
   DatasetOptions d;
   d.format = *playback::format_from_name(o.format);
   d.features = c.features;
   d.trim = c.trimmed;
-  auto clips = load_clips(o.inputs, map, d);
+  d.read = read_options(o);
+  LoadReport report;
+  auto clips = load_clips(o.inputs, map, d, &report);
+  for (const auto& p : report.skipped) std::fprintf(stderr, "note: %s\n", p.c_str());
+  for (const auto& p : report.bad) bad.add(p);
   std::vector<int> per(map.classes.size(), 0);
   int unlabelled = 0;
   for (const auto& clip : clips) clip.label >= 0 ? ++per[static_cast<std::size_t>(clip.label)] : ++unlabelled;
@@ -137,7 +149,8 @@ nlohmann::json config_json(const ClassifierOptions& c) {
 int gesture_train(const GestureOptions& o) {
   const auto map = class_map(o.classes);
   const auto c = classifier_options(o);
-  const auto clips = load(o, map, c);
+  BadInputs bad;
+  const auto clips = load(o, map, c, bad);
   std::fprintf(stderr, "training %zu models ...\n", map.classes.size());
   const auto model = Classifier::train(clips, map, c);
   if (!o.out.empty()) model.save(o.out);
@@ -149,7 +162,7 @@ int gesture_train(const GestureOptions& o) {
     std::printf("trained %zu models (%zu classes) on %zu clips; rejection threshold %.3f log-likelihood per frame%s\n", model.models().size(), map.classes.size(),
                 clips.size(), model.threshold(), o.out.empty() ? " (not saved: no --out)" : ("; saved to " + o.out).c_str());
   }
-  return 0;
+  return bad.exit_code(0, expand_paths(o.inputs).size());
 }
 
 struct CvRun {
@@ -178,7 +191,8 @@ CvRun run_cv(const GestureOptions& o, const ClassMap& map, const std::vector<Cli
 int gesture_cv(const GestureOptions& o) {
   const auto map = class_map(o.classes);
   const auto base = classifier_options(o);
-  const auto clips = load(o, map, base);
+  BadInputs bad;
+  const auto clips = load(o, map, base, bad);
   std::vector<ClassifierOptions> configs;
   if (o.sweep) {
     const std::vector<int> states = o.sweep_states.empty() ? std::vector<int>{3, 5, 7, 9} : o.sweep_states;
@@ -269,7 +283,7 @@ int gesture_cv(const GestureOptions& o) {
       }
     }
     std::printf("%s\n", j.dump(2).c_str());
-    return 0;
+    return bad.exit_code(0, expand_paths(o.inputs).size());
   }
   if (o.sweep) {
     std::printf("%-6s %-7s %-9s %-9s %-9s %s\n", "states", "mixt.", "cov.", "init", "accuracy", ("F1 " + map.classes[0]).c_str());
@@ -305,16 +319,18 @@ int gesture_cv(const GestureOptions& o) {
                 n.recall[0], n.f1[0]);
   }
   if (!o.svg.empty()) std::printf("confusion matrix written to %s\n", o.svg.c_str());
-  return 0;
+  return bad.exit_code(0, expand_paths(o.inputs).size());
 }
 
 // Leave-subject-out spotting in continuous streams of real clips (gesture/clip_spotting.hpp).
 int gesture_spot(const GestureOptions& o) {
   const auto map = class_map(o.classes);
   const auto c = classifier_options(o);
-  const auto clips = load(o, map, c);
+  BadInputs bad;
+  const auto clips = load(o, map, c, bad);
   ClipStreamOptions so;
   so.format = *playback::format_from_name(o.format);
+  so.read = read_options(o);
   so.gap_s = o.gap;
   so.rest_s = o.rest;
   so.spot = o.spot;
@@ -338,7 +354,7 @@ int gesture_spot(const GestureOptions& o) {
                                         {"spotting", to_json(r.combined)}, {"subjects", per}}
                             .dump(2)
                             .c_str());
-    return 0;
+    return bad.exit_code(0, expand_paths(o.inputs).size());
   }
   const auto& t = r.combined;
   std::printf("leave-subject-out spotting in continuous streams of %zu clips (%.1f s of the last frame held, %.1f s of arms-down rest "
@@ -347,7 +363,7 @@ int gesture_spot(const GestureOptions& o) {
               "its clips (%.2f h); latency from the end of the motion: median %.0f ms\n",
               r.label.c_str(), t.truth, t.events, t.precision, t.recall, t.f1, t.false_per_hour, t.non_gesture_s / 3600.0,
               1e3 * t.median_latency_s);
-  return 0;
+  return bad.exit_code(0, expand_paths(o.inputs).size());
 }
 
 int gesture_classify(const GestureOptions& o) {
@@ -356,10 +372,22 @@ int gesture_classify(const GestureOptions& o) {
   d.format = *playback::format_from_name(o.format);
   d.features.set = model.feature_set();
   d.trim = model.trimmed();
+  d.read = read_options(o);
   nlohmann::json all = nlohmann::json::array();
-  for (const auto& file : expand_paths(o.inputs)) {
-    const auto rec = playback::read_recording(d.format, file);
-    const auto x = clip_features(rec, d);
+  BadInputs bad;
+  const auto files = expand_paths(o.inputs);
+  for (const auto& file : files) {
+    Sequence x;
+    if (!bad.guard([&] {
+          const auto rec = playback::read_recording(d.format, file, d.read);
+          note_skipped(rec);
+          if (rec.frames.size() < 2)
+            throw playback::DataError(file, rec.report.last_line, "one skeleton frame only: a clip needs at least 2");
+          x = clip_features(rec, d);
+        })) {
+      if (o.json) all.push_back({{"file", file}, {"error", bad.messages().back()}});
+      continue;
+    }
     const auto dec = model.classify(x);
     const std::string label = dec.rejected ? "none" : model.labels()[static_cast<std::size_t>(dec.label)];
     if (o.json) {
@@ -377,7 +405,7 @@ int gesture_classify(const GestureOptions& o) {
     }
   }
   if (o.json) std::printf("%s\n", all.dump(2).c_str());
-  return 0;
+  return bad.exit_code(0, files.size());
 }
 
 int gesture_features(const GestureOptions& o) {
@@ -388,8 +416,12 @@ int gesture_features(const GestureOptions& o) {
   std::printf("file,frame,stamp_s,complete");
   for (const auto& n : names) std::printf(",%s", n.c_str());
   std::printf("\n");
-  for (const auto& file : expand_paths(o.inputs)) {
-    const auto rec = playback::read_recording(format, file);
+  BadInputs bad;
+  const auto files = expand_paths(o.inputs);
+  for (const auto& file : files) {
+    playback::Recording rec;
+    if (!bad.guard([&] { rec = playback::read_recording(format, file, read_options(o)); })) continue;
+    note_skipped(rec);
     const auto ft = recording_features(rec, f);
     for (Eigen::Index t = 0; t < ft.x.rows(); ++t) {
       const auto& s = rec.frames[static_cast<std::size_t>(t)];
@@ -399,7 +431,7 @@ int gesture_features(const GestureOptions& o) {
       std::printf("\n");
     }
   }
-  return 0;
+  return bad.exit_code(0, files.size());
 }
 
 nlohmann::json event_json(const SpottedEvent& e) {
@@ -548,6 +580,9 @@ void add_common(CLI::App* c, GestureOptions& o, bool model_options) {
   c->add_option("inputs", o.inputs, "recordings (files, or directories of .csv files)")->required()->check(CLI::ExistingPath);
   c->add_option("--format", o.format, "input format (default kinder-gator)")->check(CLI::IsMember(playback::format_names()));
   c->add_flag("--json", o.json, "machine-readable output");
+  c->add_option("--on-error", o.on_error, "a bad line in an input: stop (default: the file is bad, reported, the others still "
+                                          "read, exit 2 at the end) or skip the line")
+      ->check(CLI::IsMember({"stop", "skip"}));
   if (!model_options) return;
   c->add_flag("--no-trim", o.no_trim, "keep each clip whole (default: only the part where the arms move)");
   c->add_option("--classes", o.classes, "two-class (point vs garbage; default), five-class, or a class-mapping YAML file");

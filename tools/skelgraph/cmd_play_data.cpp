@@ -16,11 +16,17 @@ namespace skelgraph::cli {
 
 namespace {
 
-// Reads the files (no DDS) and prints what a replay would publish.
+// Reads the files (no DDS) and prints what a replay would publish; a bad file
+// is reported (and listed with its error) and the others still read.
 int info(playback::Format format, const std::vector<std::string>& files, const playback::ReadOptions& opt) {
   nlohmann::json out = nlohmann::json::array();
+  BadInputs bad;
   for (const auto& f : files) {
-    const auto rec = playback::read_recording(format, f, opt);
+    playback::Recording rec;
+    if (!bad.guard([&] { rec = playback::read_recording(format, f, opt); })) {
+      out.push_back({{"file", f}, {"error", bad.messages().back()}});
+      continue;
+    }
     std::map<std::string, std::set<std::uint32_t>> people;
     std::size_t lost = 0;
     for (const auto& s : rec.frames) {
@@ -45,7 +51,7 @@ int info(playback::Format format, const std::vector<std::string>& files, const p
                    {"problems", rec.report.problems}});
   }
   std::printf("%s\n", out.dump(2).c_str());
-  return 0;
+  return bad.exit_code(0, files.size());
 }
 
 }  // namespace
@@ -78,11 +84,7 @@ void add_play_data_command(CLI::App& app, GlobalOptions& g, Action& run) {
         playback::ReadOptions opt;
         opt.on_error = o->on_error == "skip" ? playback::ReadOptions::OnError::Skip : playback::ReadOptions::OnError::Stop;
         opt.sensor_id = o->sensor_id;
-        try {
-          return info(*playback::format_from_name(o->format), o->files, opt);
-        } catch (const playback::DataError& e) {
-          throw UsageError(e.what());
-        }
+        return info(*playback::format_from_name(o->format), o->files, opt);
       }
       const auto registry = runtime::builtin_registry();
       std::vector<runtime::RawParam> raw = {{"format", o->format, "play-data"},

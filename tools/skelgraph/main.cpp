@@ -14,6 +14,7 @@
 #include <spdlog/spdlog.h>
 
 #include "cli.hpp"
+#include "skelgraph/gesture/hmm.hpp"
 
 namespace skelgraph::cli {
 
@@ -80,6 +81,21 @@ void Progress::done(bool keep) {
   if (keep) std::fprintf(stderr, "\n");
   else std::fprintf(stderr, "\r%*s\r", static_cast<int>(shown_.size()), "");
   shown_.clear();
+}
+
+void BadInputs::add(const std::string& message) {
+  messages_.push_back(playback::printable(message));
+  std::fprintf(stderr, "error: %s\n", messages_.back().c_str());
+}
+
+void note_skipped(const playback::Recording& recording) {
+  if (const auto s = playback::skipped_summary(recording); !s.empty()) std::fprintf(stderr, "note: %s\n", s.c_str());
+}
+
+int BadInputs::exit_code(int rc, std::size_t inputs) const {
+  if (messages_.empty()) return rc;
+  std::fprintf(stderr, "error: %zu of %zu inputs were bad input (see above); the others were processed\n", messages_.size(), inputs);
+  return 2;
 }
 
 const CLI::Validator kNonNegative = number_check(true);
@@ -178,13 +194,19 @@ int main(int argc, char** argv) {
   try {
     rc = run ? run() : 2;
   } catch (const UsageError& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
+    std::fprintf(stderr, "error: %s\n", skelgraph::playback::printable(e.what()).c_str());
     rc = 2;
   } catch (const skelgraph::runtime::LaunchError& e) {
+    std::fprintf(stderr, "error: %s\n", skelgraph::playback::printable(e.what()).c_str());
+    rc = 2;
+  } catch (const skelgraph::playback::DataError& e) {  // a bad input file (file:line: what)
     std::fprintf(stderr, "error: %s\n", e.what());
     rc = 2;
+  } catch (const skelgraph::gesture::ModelError& e) {  // a bad model, class map or clip
+    std::fprintf(stderr, "error: %s\n", skelgraph::playback::printable(e.what()).c_str());
+    rc = 2;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
+    std::fprintf(stderr, "error: %s\n", skelgraph::playback::printable(e.what()).c_str());
     rc = 1;
   }
   spdlog::shutdown();

@@ -65,7 +65,7 @@ Stream make_stream(const std::vector<Clip>& clips, const std::vector<std::size_t
   std::int64_t t0 = 0;
   const auto gap = static_cast<std::int64_t>(o.gap_s * 1e9);
   for (std::size_t i : idx) {
-    const auto rec = playback::read_recording(o.format, clips[i].source);
+    const auto rec = playback::read_recording(o.format, clips[i].source, o.read);
     const auto rec_wrists = wrists_of(rec);
     const auto wrist_at = [&](std::size_t k) { return rec_wrists.empty() ? Wrists{} : rec_wrists[k]; };
     if (o.rest_s > 0) {

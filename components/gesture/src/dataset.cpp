@@ -47,25 +47,45 @@ Sequence clip_features(const playback::Recording& recording, const DatasetOption
   return x.middleRows(s.begin, s.end - s.begin);
 }
 
-std::vector<Clip> load_clips(const std::vector<std::string>& paths, const ClassMap& map, const DatasetOptions& o) {
+namespace {
+Clip load_clip(const std::string& file, const ClassMap& map, const DatasetOptions& o, LoadReport* report) {
+  const auto rec = playback::read_recording(o.format, file, o.read);
+  if (report && rec.report.skipped > 0) report->skipped.push_back(playback::skipped_summary(rec));
+  Clip c;
+  c.source = file;
+  const auto meta = [&](const char* k) {
+    const auto it = rec.metadata.find(k);
+    return it == rec.metadata.end() ? std::string() : it->second;
+  };
+  c.action = meta("action");
+  if (c.action.empty()) c.action = meta("gesture");
+  if (c.action.empty())
+    throw playback::DataError(file, 1, "no action label (expected 'action' or 'gesture' metadata, or a format's action column)");
+  c.subject = meta("subject");
+  if (c.subject.empty()) c.subject = std::filesystem::path(file).stem().string();
+  if (rec.frames.size() < 2)
+    throw playback::DataError(file, rec.report.last_line, "one skeleton frame only: a clip needs at least 2");
+  c.label = map.label_of(c.action).value_or(-1);
+  c.x = clip_features(rec, o);
+  return c;
+}
+}  // namespace
+
+std::vector<Clip> load_clips(const std::vector<std::string>& paths, const ClassMap& map, const DatasetOptions& o,
+                             LoadReport* report) {
   std::vector<Clip> clips;
   for (const auto& file : expand_paths(paths)) {
-    const auto rec = playback::read_recording(o.format, file);
-    Clip c;
-    c.source = file;
-    const auto meta = [&](const char* k) {
-      const auto it = rec.metadata.find(k);
-      return it == rec.metadata.end() ? std::string() : it->second;
-    };
-    c.action = meta("action");
-    if (c.action.empty()) c.action = meta("gesture");
-    if (c.action.empty()) throw ModelError(file + ": no action label in the recording (expected 'action' or 'gesture' metadata)");
-    c.subject = meta("subject");
-    if (c.subject.empty()) c.subject = std::filesystem::path(file).stem().string();
-    if (rec.frames.size() < 2) throw ModelError(file + ": fewer than 2 frames");
-    c.label = map.label_of(c.action).value_or(-1);
-    c.x = clip_features(rec, o);
-    clips.push_back(std::move(c));
+    if (!report) {
+      clips.push_back(load_clip(file, map, o, nullptr));
+      continue;
+    }
+    try {
+      clips.push_back(load_clip(file, map, o, report));
+    } catch (const playback::DataError& e) {
+      report->bad.push_back(e.what());
+    } catch (const ModelError& e) {
+      report->bad.push_back(playback::printable(e.what()));
+    }
   }
   return clips;
 }

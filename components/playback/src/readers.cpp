@@ -79,6 +79,7 @@ void read_rows(CsvReader& csv, const ReadOptions& opt, Recording& rec, Parse par
       if (rec.report.problems.size() < kMaxProblems) rec.report.problems.push_back(e.what());
     }
   }
+  rec.report.last_line = csv.line();
 }
 
 // The wrists of the frame about to be appended (call just before rec.frames.push_back).
@@ -426,7 +427,8 @@ Recording read_generic(const std::string& path, const ReadOptions& opt) {
 
 }  // namespace
 
-Recording read_recording(Format format, const std::string& path, const ReadOptions& options) {
+namespace {
+Recording read_any(Format format, const std::string& path, const ReadOptions& options) {
   switch (format) {
     case Format::Generic: return read_generic(path, options);
     case Format::KinderGator: return read_kinder_gator(path, options);
@@ -435,6 +437,29 @@ Recording read_recording(Format format, const std::string& path, const ReadOptio
     case Format::GesturePhase: return read_gesture_phase(path, options);
   }
   throw std::invalid_argument("unknown format");
+}
+}  // namespace
+
+Recording read_recording(Format format, const std::string& path, const ReadOptions& options) {
+  auto rec = read_any(format, path, options);
+  if (rec.frames.empty()) {
+    const auto& r = rec.report;
+    throw DataError(path, r.last_line,
+                    r.lines == 0 ? std::string("no data rows: expected skeleton frames after the header")
+                    : r.skipped == r.lines
+                        ? "no skeleton frames: every one of the " + std::to_string(r.lines) + " data rows was bad (first: " +
+                              (r.problems.empty() ? std::string("?") : r.problems.front()) + ")"
+                        : "no skeleton frames in " + std::to_string(r.lines) + " data rows (nobody tracked)");
+  }
+  return rec;
+}
+
+std::string skipped_summary(const Recording& rec) {
+  const auto& r = rec.report;
+  if (r.skipped == 0) return {};
+  return printable(rec.source + ": " + std::to_string(r.skipped) + " bad line" + (r.skipped == 1 ? "" : "s") + " of " +
+                   std::to_string(r.lines) + " skipped (first: " + (r.problems.empty() ? std::string("?") : r.problems.front()) +
+                   ")");
 }
 
 void write_generic_csv(const Recording& rec, std::ostream& out) {

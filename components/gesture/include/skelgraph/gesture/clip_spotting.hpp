@@ -24,6 +24,7 @@ namespace skelgraph::gesture {
 
 struct ClipStreamOptions {
   playback::Format format = playback::Format::KinderGator;  // of the clips' source files
+  playback::ReadOptions read;                               // ... and how they were read
   double gap_s = 0.0;   // the last frame of a clip held this long before the next
   double rest_s = 0.0;  // arms down and still this long between clips (0: none)
   SpotterOptions spot;

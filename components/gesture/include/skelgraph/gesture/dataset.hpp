@@ -14,6 +14,7 @@ struct DatasetOptions {
   playback::Format format = playback::Format::KinderGator;
   FeatureOptions features;
   bool trim = true;  // keep only the motion_span of each clip (the idle start and end are alike in every class)
+  playback::ReadOptions read;  // a bad line: stop (the file is bad) or skip it
 };
 
 // The recording's wrists, one per frame (from extra_joints); empty when it has none.
@@ -30,8 +31,14 @@ Sequence clip_features(const playback::Recording& recording, const DatasetOption
 // action from the recording's "action" (or "gesture") metadata, the subject
 // from "subject" (else the file name), the label from the class map (-1 if
 // the action is in no class). Throws playback::DataError / ModelError naming
-// the file.
-std::vector<Clip> load_clips(const std::vector<std::string>& paths, const ClassMap& map, const DatasetOptions& options);
+// the file; with a report, a bad file's message goes there instead and the
+// other files are still read.
+struct LoadReport {
+  std::vector<std::string> bad;      // a file each that was left out: "FILE:LINE: what"
+  std::vector<std::string> skipped;  // a file each whose bad lines were skipped (ReadOptions::OnError::Skip)
+};
+std::vector<Clip> load_clips(const std::vector<std::string>& paths, const ClassMap& map, const DatasetOptions& options,
+                             LoadReport* report = nullptr);
 
 // The files `paths` name: files as given, directories expanded to their *.csv files.
 std::vector<std::string> expand_paths(const std::vector<std::string>& paths);

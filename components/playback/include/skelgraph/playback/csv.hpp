@@ -6,15 +6,21 @@
 #include <fstream>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace skelgraph::playback {
 
-// A problem in an input file, with where and what was expected.
+// `text` safe to print on a terminal: control bytes (and DEL) as \n, \r, \t
+// or \xNN; everything else, UTF-8 included, as it is.
+std::string printable(std::string_view text);
+
+// A problem in an input file, with where and what was expected. The message
+// is printable(): input quoted in it cannot send control bytes to a terminal.
 class DataError : public std::runtime_error {
  public:
   DataError(const std::string& file, std::size_t line, const std::string& what)
-      : std::runtime_error(file + ":" + std::to_string(line) + ": " + what), file_(file), line_(line) {}
+      : std::runtime_error(printable(file + ":" + std::to_string(line) + ": " + what)), file_(file), line_(line) {}
   const std::string& file() const { return file_; }
   std::size_t line() const { return line_; }
 

@@ -37,6 +37,7 @@ struct ReadReport {
   std::size_t lines = 0;            // data lines read
   std::size_t skipped = 0;          // bad lines skipped (OnError::Skip)
   std::size_t repeated_stamps = 0;  // frames with the same stamp as the one before (kept)
+  std::size_t last_line = 0;        // the file's last line read (where "no frames" is reported)
   std::vector<std::string> problems;  // the first 20 messages of skipped lines
 };
 
@@ -53,8 +54,13 @@ struct Recording {
   ReadReport report;
 };
 
-// Throws DataError (file:line: what was expected) on bad input under OnError::Stop.
+// Throws DataError (file:line: what was expected) on bad input under
+// OnError::Stop, and under either policy when the file gives no skeleton frame
+// at all (empty, header only, every line bad, or nobody tracked).
 Recording read_recording(Format format, const std::string& path, const ReadOptions& options = {});
+
+// "FILE: N bad lines skipped (first: ...)" when lines were skipped, else "".
+std::string skipped_summary(const Recording& recording);
 
 // skelgraph's own CSV: "# skelgraph skeleton csv v1", "# key: value" metadata
 // lines, a header, then one row per skeleton with every joint's position,
