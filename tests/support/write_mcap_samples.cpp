@@ -73,8 +73,12 @@ int main(int argc, char** argv) {
   g.label("pointing");
   g.person_id(1);
   g.score(3.25);
+  g.has_ray(true);
+  g.ray_origin().y(1.4);
+  g.ray_direction().x(0.6);
+  g.ray_direction().y(-0.8);
   g.has_target(true);
-  g.target().x(1.5);
+  g.target().x(1.05);
   put("skelgraph/gesture/event", g);
   msg::ComponentStatus st;
   st.component_name("sim");

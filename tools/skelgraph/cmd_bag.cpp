@@ -24,6 +24,7 @@
 #include "skelgraph/recording/session_recorder.hpp"
 #include "skelgraph/recording/tick_frames.hpp"
 #include "skelgraph/runtime/topics.hpp"
+#include "skelgraph/scene/scene_export.hpp"
 #include "skelgraph/skeleton/skeleton_msg.hpp"
 
 namespace skelgraph::cli {
@@ -227,6 +228,46 @@ int import(playback::Format format, const std::vector<std::string>& files, const
   bag.close();
   if (json) std::printf("%s\n", nlohmann::json{{"out", out}, {"frames", frames}, {"files", files}}.dump(2).c_str());
   else std::printf("%s: %llu skeletons from %zu file(s)\n", out.c_str(), static_cast<unsigned long long>(frames), files.size());
+  return 0;
+}
+
+// The recording with the cell as a 3-D scene for Foxglove/Lichtblick added (scene_export.hpp).
+int export_scene(const std::string& file, const std::string& out, const std::string& compression, bool json) {
+  mcap::WriterOptions w;
+  w.compression = *mcap::compression_from_name(compression);
+  Progress progress(!json);
+  const auto r = user_input([&] {
+    return scene::export_scene(file, out, {}, w, [&](std::uint64_t done, std::uint64_t total) {
+      progress("copied " + std::to_string(done) + "/" + std::to_string(total) + " messages", done >= total);
+    });
+  });
+  progress.done();
+  if (json) {
+    std::printf("%s\n", nlohmann::json{{"out", out},
+                                       {"copied", r.copied},
+                                       {"skeletons", r.skeletons},
+                                       {"poses", r.poses},
+                                       {"pointing", r.pointing},
+                                       {"robot_states", r.robot_states},
+                                       {"scene_updates", r.updates},
+                                       {"entities", r.entities},
+                                       {"transforms", r.transforms},
+                                       {"undecodable", r.undecodable},
+                                       {"unplaced_frames", r.unplaced}}
+                            .dump(2)
+                            .c_str());
+  } else {
+    std::printf("%s: the %llu messages of %s, and the scene: %llu updates (%llu entities from %llu skeletons, %llu pointing "
+                "events, %llu robot states) on %s, %llu transforms on %s\n",
+                out.c_str(), static_cast<unsigned long long>(r.copied), file.c_str(), static_cast<unsigned long long>(r.updates),
+                static_cast<unsigned long long>(r.entities), static_cast<unsigned long long>(r.skeletons),
+                static_cast<unsigned long long>(r.pointing), static_cast<unsigned long long>(r.robot_states), scene::kSceneTopic,
+                static_cast<unsigned long long>(r.transforms), scene::kTransformTopic);
+  }
+  for (const auto& f : r.unplaced)
+    std::fprintf(stderr, "note: frame '%s' has no pose in the recording: drawn at the world's origin\n", f.c_str());
+  if (r.undecodable > 0) std::fprintf(stderr, "warning: %llu messages did not decode and are not in the scene\n",
+                                      static_cast<unsigned long long>(r.undecodable));
   return 0;
 }
 
@@ -454,7 +495,7 @@ void add_bag_command(CLI::App& app, GlobalOptions& g, Action& run) {
     std::string file, out, format = "csv", compression = "zstd", on_error = "stop", sensor_id;
     std::vector<std::string> files;
     double max_age_ms = 100;
-    bool json = false;
+    bool json = false, scene = false;
   };
   auto o = std::make_shared<Opts>();
 
@@ -563,13 +604,23 @@ void add_bag_command(CLI::App& app, GlobalOptions& g, Action& run) {
     };
   });
 
-  auto* ex = bag->add_subcommand("export", "Skeletons of a recording to CSV files, one per topic and sensor");
+  auto* ex = bag->add_subcommand("export", "Skeletons of a recording to CSV files, one per topic and sensor; or with --scene the "
+                                          "recording with the cell as a 3-D scene for Foxglove/Lichtblick added");
   ex->add_option("file", o->file, "MCAP file")->required()->check(CLI::ExistingFile);
-  ex->add_option("--format", o->format, "csv: numeric columns (x, y, z, confidence per joint); generic: skelgraph's lossless CSV")
+  auto* fmt = ex->add_option("--format", o->format, "csv: numeric columns (x, y, z, confidence per joint); generic: skelgraph's lossless CSV")
       ->check(CLI::IsMember({"csv", "generic"}));
-  ex->add_option("--out", o->out, "output directory")->required();
+  auto* scene_flag = ex->add_flag("--scene", o->scene,
+               "--out is an MCAP file: every message of FILE plus foxglove::SceneUpdate on skelgraph/scene/update (skeletons, "
+               "sensors, pointing, the robot) and foxglove::FrameTransform on skelgraph/scene/transforms");
+  scene_flag->excludes(fmt);
+  ex->add_option("--compression", o->compression, "--scene: chunk compression (default zstd)")
+      ->check(CLI::IsMember({"none", "lz4", "zstd"}))
+      ->needs(scene_flag);
+  ex->add_option("--out", o->out, "output directory (--scene: the MCAP file)")->required();
   ex->add_flag("--json", o->json, "machine-readable summary");
-  ex->callback([o, &run] { run = [o] { return export_bag(o->file, o->format, o->out, o->json); }; });
+  ex->callback([o, &run] {
+    run = [o] { return o->scene ? export_scene(o->file, o->out, o->compression, o->json) : export_bag(o->file, o->format, o->out, o->json); };
+  });
 
   auto* mg = bag->add_subcommand("merge", "Several hosts' recordings of a session onto the sync master's timeline");
   mg->add_option("files", o->files, "recordings (one per host)")->required()->check(CLI::ExistingFile);

@@ -122,7 +122,7 @@ struct Evaluator::Impl {
                  const std::string& recorded) {
     auto fo = options.fuser;
     fo.method = m;
-    Lane lane{kind, {}, fusion::Fuser(fo), only, m, {}, recorded, {}, {}};
+    Lane lane{kind, {}, fusion::Fuser(fo), only, m, {}, recorded, {}, {}, {}};
     lane.score.name = name;
     lane.score.fused = kind != Lane::Kind::Single;
     lane.score.ticks = result.ticks;  // a stream added late had nothing to show on the ticks before

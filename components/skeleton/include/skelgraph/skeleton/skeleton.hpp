@@ -81,6 +81,17 @@ struct Skeleton {
   const Joint& operator[](JointId id) const { return joints[static_cast<std::size_t>(id)]; }
 };
 
+// A sensor's pose in `frame_id` (where its frame's origin and axes are).
+struct SensorPose {
+  std::string sensor_id;
+  std::string frame_id = "world";
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  // frame_id <- sensor
+  std::int64_t stamp_ns = 0;
+  std::string method;  // "ground_truth", "checkerboard", "skeleton", "manual"
+  double rms_residual_m = 0.0;
+  double max_residual_m = 0.0;
+};
+
 // Where a skeleton is: the torso if reported, else the mean of the joints
 // reported with any confidence. Empty when nothing is.
 std::optional<Eigen::Vector3d> centre_of(const Skeleton& s);
