@@ -3,8 +3,8 @@
 # (tests/npm/check_scene.mjs: the schemas are @foxglove/schemas' own, every
 # message decodes and re-encodes, every skeleton entity matches its source
 # skeleton, every frame resolves to `cell`), for:
-# 1. the demo's live session (raw, fused, truth, the sensors' poses): the demo
-#    writes scene.mcap next to its report;
+# 1. the demo's live session (raw, fused, truth, the sensors' poses): its
+#    recorder writes the scene into the recording as samples arrive;
 # 2. one file of every wire type (tests/support/write_mcap_samples): pointing
 #    and the robot's capsules become entities;
 # 3. real data sets imported (Kinder-Gator, KinectMultiTrack) and exported
@@ -16,14 +16,15 @@ NPM_DIR=${2:?usage: scene_npm.sh SKELGRAPH NPM_DIR WRITE_MCAP_SAMPLES}
 SAMPLES=${3:?}
 WRITE_IDL=$SKELGRAPH_SOURCE_DIR/components/scene/schemas/write_idl.cjs
 DATA=${SKELGRAPH_DATA_DIR:-$SKELGRAPH_SOURCE_DIR/../shared/data}
-check() {  # check SCENE.mcap OUT.json
-  node "$NPM_DIR/check_scene.mjs" "$1" "$WRITE_IDL" >"$2" 2>"$2.err" || fail "check_scene $1: $(cat "$2.err")"
+check() {  # check SCENE.mcap OUT.json [live]
+  node "$NPM_DIR/check_scene.mjs" "$1" "$WRITE_IDL" ${3:-} >"$2" 2>"$2.err" || fail "check_scene $1: $(cat "$2.err")"
 }
 
-# 1. The demo (short): its scene recording.
+# 1. The demo (short): its recording has the scene, written live by its recorder.
 "$S" demo --duration 6 --report "$WORK/demo" >"$WORK/demo.out" 2>"$WORK/demo.err" || fail "demo: $(tail -5 "$WORK/demo.err")"
-[ -f "$WORK/demo/scene.mcap" ] || fail "the demo wrote no scene.mcap: $(ls "$WORK/demo")"
-check "$WORK/demo/scene.mcap" "$WORK/demo_scene.json"
+rec=$(ls "$WORK"/demo/recording/*.mcap | head -1)
+[ -f "$rec" ] || fail "the demo recorded nothing: $(ls -R "$WORK/demo")"
+check "$rec" "$WORK/demo_scene.json" live
 json_check "$WORK/demo_scene.json" 'd["byKind"]["raw"] > 50 and d["byKind"]["fused"] > 50 and d["byKind"]["truth"] > 50 and d["byKind"]["sensor"] >= 2 and d["frames"] == ["sensor1", "sensor2", "world"] and d["skeletonEntities"] > 150'
 ok "the demo's scene: $(cat "$WORK/demo_scene.json")"
 

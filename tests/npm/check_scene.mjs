@@ -11,7 +11,10 @@
 //   translucent where the joint is inferred, bones as a line list; per tick
 //   one entity per stream, sensor and person that had a skeleton in it;
 // - every entity's frame resolves through the transforms to one root, `cell`.
-// Usage: node check_scene.mjs SCENE.mcap WRITE_IDL.cjs   (prints a JSON summary)
+// Usage: node check_scene.mjs SCENE.mcap WRITE_IDL.cjs [live]   (prints a JSON summary)
+// live: written by the recorder as samples arrived (receive times from several
+// DDS threads, a few microseconds out of order): the entity count per tick may
+// be off by 1 %.
 import fs from "node:fs";
 import path from "node:path";
 import { createRequire } from "node:module";
@@ -21,7 +24,7 @@ import { MessageReader, MessageWriter } from "@foxglove/omgidl-serialization";
 import zstd from "@foxglove/wasm-zstd";
 import lz4 from "@foxglove/wasm-lz4";
 
-const [file, writeIdl] = process.argv.slice(2);
+const [file, writeIdl, mode] = process.argv.slice(2);
 const fail = (msg) => {
   console.error(`FAIL: ${file}: ${msg}`);
   process.exit(1);
@@ -127,6 +130,7 @@ for (const e of entities) {
     fail(`entity ${e.id}: bones not one line list`);
   }
 }
-if (skeletonEntities !== ticks.size) fail(`${skeletonEntities} skeleton entities, ${ticks.size} (stream, sensor, person, tick) with a skeleton`);
+const slack = mode === "live" ? Math.ceil(0.01 * ticks.size) : 0;
+if (Math.abs(skeletonEntities - ticks.size) > slack) fail(`${skeletonEntities} skeleton entities, ${ticks.size} (stream, sensor, person, tick) with a skeleton`);
 console.log(JSON.stringify({ file, updates, transforms, entities: entities.length, skeletonEntities, spheres, translucent,
   frames: [...parents.keys()].sort(), byKind: count }));

@@ -502,7 +502,7 @@ void add_bag_command(CLI::App& app, GlobalOptions& g, Action& run) {
   struct RecOpts {
     std::string dir = "recordings", label = "manual", compression = "zstd", host;
     std::vector<std::string> topics;
-    bool now = false, depth = false;
+    bool now = false, depth = false, scene = false;
     double rate = 1.0;
     bool loop = false;
     RunOptions run;
@@ -514,6 +514,7 @@ void add_bag_command(CLI::App& app, GlobalOptions& g, Action& run) {
   rec->add_option("--label", r->label, "session label with --now");
   rec->add_option("--topics", r->topics, "topics to record (default: every skelgraph topic but depth)");
   rec->add_flag("--include-depth", r->depth, "also record skelgraph/depth");
+  rec->add_flag("--scene", r->scene, "also write the cell as a 3-D scene for Foxglove/Lichtblick into each file (as bag export --scene)");
   rec->add_option("--compression", r->compression, "chunk compression")->check(CLI::IsMember({"none", "lz4", "zstd"}));
   rec->add_option("--host", r->host, "host name for file names and acks (default: this host)");
   add_run_options(*rec, r->run);
@@ -525,7 +526,8 @@ void add_bag_command(CLI::App& app, GlobalOptions& g, Action& run) {
                                             {"label", r->label, "bag record"},
                                             {"include_depth", r->depth ? "true" : "false", "bag record"},
                                             {"compression", r->compression, "bag record"},
-                                            {"host", r->host, "bag record"}};
+                                            {"host", r->host, "bag record"},
+                                            {"scene", r->scene ? "true" : "false", "bag record"}};
       if (!r->topics.empty()) raw.push_back({"topics", r->topics, "bag record"});
       return run_component(g, "recorder", raw, r->run);
     };

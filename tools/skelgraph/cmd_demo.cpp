@@ -27,7 +27,6 @@
 #include "report.hpp"
 #include "skelgraph/eval/safety.hpp"
 #include "skelgraph/gesture/builtin_models.hpp"
-#include "skelgraph/scene/scene_export.hpp"
 #include "skelgraph/gesture/sim_sessions.hpp"
 #include "run_graph.hpp"
 #include "skelgraph/runtime/launch_file.hpp"
@@ -225,10 +224,6 @@ int run_demo(const DemoOptions& o, GlobalOptions& g) {
         file, report_dir.string(),
         "live graph: 360, 2 sensors (recorded; offline re-runs and what the live fusion components published)");
     out["live_evaluation"] = live.summary;
-    // The same session as a 3-D scene for Foxglove/Lichtblick, next to the report.
-    const auto scene_file = (report_dir / "scene.mcap").string();
-    const auto scene = scene::export_scene(file, scene_file);
-    out["scene"] = {{"file", scene_file}, {"updates", scene.updates}, {"entities", scene.entities}, {"transforms", scene.transforms}};
     std::fprintf(stderr, "[demo 3/5] pointing: the built-in classifier (trained by the build on %d simulated sessions), "
                  "spotting in 4 others\n", gesture::kTrainSessions);
     const auto pointing = pointing_section();
@@ -258,7 +253,8 @@ int run_demo(const DemoOptions& o, GlobalOptions& g) {
                   p["f1"].get<double>(), p["true_positive"].get<int>(), p["truth"].get<int>(), p["false_positive"].get<int>(),
                   1e3 * p["median_latency_from_hold_s"].get<double>(), 100 * p["median_target_error_m"].get<double>());
       std::printf("report: %s\n", out["report"].get<std::string>().c_str());
-      std::printf("scene for Foxglove/Lichtblick (open it, 3D panel, display frame 'cell'): %s\n", scene_file.c_str());
+      std::printf("the recording is also a 3-D scene for Foxglove/Lichtblick (open it, 3D panel, display frame 'cell'): %s\n",
+                  file.c_str());
     }
   }
   if (o.json) std::printf("%s\n", out.dump(2).c_str());

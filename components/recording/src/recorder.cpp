@@ -8,6 +8,7 @@
 #include "skelgraph/msg/cdr.hpp"
 #include "skelgraph/msg/message_table.hpp"
 #include "skelgraph/runtime/topics.hpp"
+#include "skelgraph/scene/scene_export.hpp"
 
 namespace skelgraph::recording {
 
@@ -25,6 +26,9 @@ runtime::ComponentInfo Recorder::describe() {
       .add_int("stop_linger_ms", 300,
                "keep recording this long after STOP, so samples in flight (the acks of the last tick) are in the file",
                0, 10000)
+      .add_bool("scene", false,
+                "also write the cell as a 3-D scene for Foxglove/Lichtblick into each file (skelgraph/scene/update, "
+                "skelgraph/scene/transforms), as `bag export --scene` does afterwards")
       .add_bool("now", false, "record from start to shutdown without waiting for the sync topic")
       .add_string("label", "manual", "session label when recording with 'now'");
   return info;
@@ -40,6 +44,7 @@ Recorder::Recorder(runtime::Context& ctx, const runtime::Params& params)
   options_.host = params.get<std::string>("host").empty() ? ctx.config().host : params.get<std::string>("host");
   options_.compression = *mcap::compression_from_name(params.get<std::string>("compression"));
   options_.flush_period_ns = params.get<std::int64_t>("flush_ms") * 1'000'000;
+  if (params.get<bool>("scene")) options_.make_tap = [] { return std::make_unique<scene::SceneTap>(); };
   topics_ = params.get<std::vector<std::string>>("topics");
   const bool depth = params.get<bool>("include_depth");
   if (topics_.empty()) {

@@ -39,6 +39,7 @@ SessionRecorder::SessionRecorder(const RecorderOptions& options, const std::stri
                                    {"host", opt_.host},
                                    {"started_ns", std::to_string(started_ns_)}});
   bag_->flush();  // the file is valid up to here even if we are killed now
+  if (opt_.make_tap) tap_ = opt_.make_tap();
 }
 
 SessionRecorder::~SessionRecorder() = default;
@@ -51,6 +52,7 @@ void SessionRecorder::record(const std::string& topic, const std::string& type_n
                   static_cast<std::uint64_t>(std::max<std::int64_t>(0, publish_ns)));
   ++counts_[topic];
   ++messages_;
+  if (tap_) tap_->add(bag_->mcap(), topic, type_name, cdr, log_ns);
 }
 
 void SessionRecorder::maybe_flush(std::int64_t now_ns) {
@@ -66,6 +68,7 @@ void SessionRecorder::finish(std::int64_t now_ns) {
   mcap::KeyValues stats{{"label", label_},      {"session_id", std::to_string(session_)},
                         {"host", opt_.host},    {"started_ns", std::to_string(started_ns_)},
                         {"stopped_ns", std::to_string(now_ns)}, {"messages", std::to_string(messages_)}};
+  if (tap_) tap_->finish(bag_->mcap());
   for (const auto& [topic, n] : counts_) stats["count " + topic] = std::to_string(n);
   bag_->write_metadata("recording", stats);
   bag_->close();

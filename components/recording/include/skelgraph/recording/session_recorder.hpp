@@ -5,6 +5,7 @@
 // Thread-safe (DDS delivers samples from several threads). No DDS here.
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -18,7 +19,19 @@ namespace skelgraph::recording {
 // `s` with anything but [A-Za-z0-9._-] replaced by '_' (file names from labels, hosts, sensor ids).
 std::string file_safe(std::string s);
 
+// Writes more into a session's file as its samples are recorded (the 3-D
+// scene: skelgraph::scene::SceneTap); called under the recorder's lock, in
+// arrival order.
+class RecordTap {
+ public:
+  virtual ~RecordTap() = default;
+  virtual void add(mcap::Writer& w, const std::string& topic, const std::string& type_name, std::string_view cdr,
+                   std::int64_t log_ns) = 0;
+  virtual void finish(mcap::Writer& w) = 0;  // before the file is closed
+};
+
 struct RecorderOptions {
+  std::function<std::unique_ptr<RecordTap>()> make_tap;  // one per file, if given
   std::string directory = "recordings";
   std::string host;                                   // goes into the file name and metadata
   mcap::Compression compression = mcap::Compression::Zstd;
@@ -56,6 +69,7 @@ class SessionRecorder {
   std::uint32_t session_;
   std::int64_t started_ns_, last_flush_ns_;
   std::unique_ptr<BagWriter> bag_;
+  std::unique_ptr<RecordTap> tap_;
   std::map<std::string, std::uint64_t> counts_;
   std::uint64_t messages_ = 0;
 };
