@@ -7,7 +7,7 @@
 #    recorder writes the scene into the recording as samples arrive;
 # 2. one file of every wire type (tests/support/write_mcap_samples): pointing
 #    and the robot's capsules become entities;
-# 3. real data sets imported (Kinder-Gator, KinectMultiTrack) and exported
+# 3. real data sets imported (Kinder-Gator, KinectMultiTrack, MSRC-12) and exported
 #    with the scene.
 # Usage: scene_npm.sh SKELGRAPH NPM_DIR WRITE_MCAP_SAMPLES   (in a loopback-only namespace)
 source "$(dirname "$0")/lib.sh"
@@ -40,8 +40,9 @@ ok "pointing and the robot as entities: $(cat "$WORK/samples_scene.json")"
 # 3. Real data sets, imported and exported with the scene.
 kg=$(ls "$DATA"/kinder-gator/adults/*Point-at-the-camera*.csv | head -1)
 kmt="$DATA/kinect-multitrack/Experiments_1_2_3_6/Study_12_Kinect_2_Time_5_01_13_PM.csv"
-[ -f "$kg" ] && [ -f "$kmt" ] || fail "$DATA is missing data sets: tests read ../shared/data (or SKELGRAPH_DATA_DIR)"
-for set in kinder-gator:"$kg" multitrack:"$kmt"; do
+msrc="$DATA/msrc12/P1_1_11_p21.csv"
+[ -f "$kg" ] && [ -f "$kmt" ] && [ -f "$msrc" ] || fail "$DATA is missing data sets: tests read ../shared/data (or SKELGRAPH_DATA_DIR)"
+for set in kinder-gator:"$kg" multitrack:"$kmt" msrc12:"$msrc"; do
   format=${set%%:*} file=${set#*:}
   "$S" bag import "$format" "$file" --out "$WORK/$format.mcap" >/dev/null 2>&1 || fail "bag import $format $file"
   "$S" bag export --scene "$WORK/$format.mcap" --out "$WORK/${format}_scene.mcap" --json >"$WORK/${format}_export.json" \

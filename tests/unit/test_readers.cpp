@@ -446,3 +446,78 @@ TEST(SharedData, GesturePhaseFilesReadWithDocumentedFramesAndLabels) {
     }
   }
 }
+
+// MSRC-12: space-separated, CRLF, µs, 20 joints x/y/z/w; all-zero lines carry no
+// skeleton; the .tagstream beside a file gives its action points.
+TEST(Readers, Msrc12SpacesZeroFramesAndTagstream) {
+  std::ostringstream os;
+  const auto row = [&](long long us, double base) {
+    os << us;
+    for (int j = 0; j < 20; ++j) os << " " << base + j << " " << 0.1 * j << " " << 2.5 << " 1.000000";
+    os << "\r\n";
+  };
+  os << "0";
+  for (int j = 0; j < 80; ++j) os << " 0";
+  os << "\r\n";
+  row(33000, 0.0);
+  row(66000, 0.5);
+  const auto path = write_file("P1_1_9_p42.csv", os.str());
+  write_file("P1_1_9_p42.tagstream", "XQPCTick;Tag\r\n2493750;G9  Start system\r\n4987500;G9  Start system\r\n");
+  const auto rec = read_recording(Format::Msrc12, path);
+  ASSERT_EQ(rec.frames.size(), 2u);
+  EXPECT_EQ(rec.report.empty_frames, 1u);
+  EXPECT_EQ(rec.frames[0].stamp_ns, 33'000'000);
+  // Kinect v1 order: HandRight (11) is the canonical right hand; its x is base + 11.
+  EXPECT_DOUBLE_EQ(rec.frames[1][JointId::RightHand].position.x(), 11.5);
+  EXPECT_DOUBLE_EQ(rec.extra_joints.at("right_wrist")[1].x(), 10.5);
+  EXPECT_EQ(rec.metadata.at("subject"), "p42");
+  EXPECT_EQ(rec.metadata.at("gesture"), "G9  Start system");
+  ASSERT_EQ(rec.annotations.size(), 2u);
+  EXPECT_EQ(rec.annotations[0].start_ns, 50'000'000);  // (2493750 * 1000 + 24937) / 49875 us
+  EXPECT_EQ(rec.annotations[1].end_ns, 100'000'000);
+  // Bad input names file:line.
+  const auto bad = write_file("P1_1_9_p43.csv", "33000 1 2 3\r\n");
+  try {
+    read_recording(Format::Msrc12, bad);
+    ADD_FAILURE() << "a short line was read";
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("P1_1_9_p43.csv:1: expected 81 fields"), std::string::npos) << e.what();
+  }
+  const auto tags = write_file("t.tagstream", "XQPCTick;Tag\r\n4987500;G9\r\n2493750;G9\r\n");
+  try {
+    read_tagstream(tags);
+    ADD_FAILURE() << "ticks going backwards were read";
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("t.tagstream:3: ticks go backwards"), std::string::npos) << e.what();
+  }
+}
+
+// The 18 MSRC-12 files: frames and tags as the data set's README counts them;
+// the one file without a single skeleton is bad input.
+TEST(SharedData, Msrc12FilesReadWithDocumentedFramesAndTags) {
+  const auto dir = fs::path(data_dir()) / "msrc12";
+  ASSERT_TRUE(fs::is_directory(dir)) << dir << " is missing: tests read ../shared/data (or SKELGRAPH_DATA_DIR)";
+  struct Want {
+    const char* file;
+    std::size_t lines, zero, tags;
+  };
+  for (const Want w : {Want{"P1_1_1_p06", 1027, 20, 9}, Want{"P1_1_10_p06", 3538, 2035, 10}, Want{"P1_1_11_p21", 2614, 20, 12},
+                       Want{"P1_1_12_p19", 923, 23, 10}, Want{"P1_1_1A_p21", 921, 20, 10}}) {
+    const auto rec = read_recording(Format::Msrc12, (dir / (std::string(w.file) + ".csv")).string());
+    EXPECT_EQ(rec.report.lines, w.lines) << w.file;
+    EXPECT_EQ(rec.report.empty_frames, w.zero) << w.file;
+    EXPECT_EQ(rec.frames.size(), w.lines - w.zero) << w.file;
+    ASSERT_EQ(rec.annotations.size(), w.tags) << w.file;
+    // Every tag falls inside its sequence's time range.
+    for (const auto& a : rec.annotations) {
+      EXPECT_GE(a.start_ns, rec.frames.front().stamp_ns - 2'100'000'000) << w.file;
+      EXPECT_LE(a.start_ns, rec.frames.back().stamp_ns) << w.file;
+    }
+  }
+  try {
+    read_recording(Format::Msrc12, (dir / "P1_1_12A_p19.csv").string());
+    ADD_FAILURE() << "an all-zero file read as a recording";
+  } catch (const DataError& e) {
+    EXPECT_NE(std::string(e.what()).find("P1_1_12A_p19.csv:1029: no skeleton frames"), std::string::npos) << e.what();
+  }
+}

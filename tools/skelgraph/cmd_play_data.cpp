@@ -45,6 +45,8 @@ int info(playback::Format format, const std::vector<std::string>& files, const p
                    {"lost_joints", lost},
                    {"metadata", rec.metadata},
                    {"labelled_frames", rec.frame_labels.size()},
+                   {"annotations", rec.annotations.size()},
+                   {"empty_frames", rec.report.empty_frames},
                    {"lines", rec.report.lines},
                    {"skipped_lines", rec.report.skipped},
                    {"repeated_stamps", rec.report.repeated_stamps},

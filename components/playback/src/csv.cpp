@@ -38,7 +38,7 @@ std::string printable(std::string_view text) {
   return out;
 }
 
-CsvReader::CsvReader(std::string path) : path_(std::move(path)), in_(path_) {
+CsvReader::CsvReader(std::string path, char separator) : path_(std::move(path)), in_(path_), separator_(separator) {
   if (!in_) throw DataError(path_, 0, "cannot open file");
 }
 
@@ -49,9 +49,20 @@ bool CsvReader::next(std::vector<std::string>& fields) {
     if (line_ == 1 && text.rfind("\xEF\xBB\xBF", 0) == 0) text.erase(0, 3);  // UTF-8 BOM
     if (trim(text).empty()) continue;
     fields.clear();
+    if (separator_ == ' ') {
+      const std::string t = trim(text);
+      std::size_t at = 0;
+      while (at < t.size()) {
+        const auto end = t.find_first_of(" \t", at);
+        fields.push_back(t.substr(at, end == std::string::npos ? std::string::npos : end - at));
+        if (end == std::string::npos) break;
+        at = t.find_first_not_of(" \t", end);
+      }
+      return true;
+    }
     std::size_t start = 0;
     while (true) {
-      const auto comma = text.find(',', start);
+      const auto comma = text.find(separator_, start);
       fields.push_back(trim(text.substr(start, comma == std::string::npos ? std::string::npos : comma - start)));
       if (comma == std::string::npos) break;
       start = comma + 1;

@@ -20,12 +20,13 @@ const char* format_name(Format f) {
     case Format::KinectV2: return "kinect-v2";
     case Format::MultiTrack: return "multitrack";
     case Format::GesturePhase: return "gesture-phase";
+    case Format::Msrc12: return "msrc12";
   }
   return "?";
 }
 
 constexpr Format kFormats[] = {Format::Generic, Format::KinderGator, Format::KinectV2, Format::MultiTrack,
-                               Format::GesturePhase};
+                               Format::GesturePhase, Format::Msrc12};
 
 std::vector<std::string> format_names() {
   std::vector<std::string> out;
@@ -146,6 +147,49 @@ Recording read_kinder_gator(const std::string& path, const ReadOptions& opt) {
       rec.metadata["action"] = f[62];
     }
     add_wrists(rec, xyz(csv, f, 1 + 3 * 6, kV1Joints[6]), xyz(csv, f, 1 + 3 * 10, kV1Joints[10]));
+    rec.frames.push_back(std::move(s));
+  });
+  return rec;
+}
+
+// ---- MSRC-12 (Kinect v1, NUI joint order; space-separated; .tagstream beside) ----
+
+Recording read_msrc12(const std::string& path, const ReadOptions& opt) {
+  auto rec = empty_recording(Format::Msrc12, path);
+  CsvReader csv(path, ' ');
+  const std::string sensor = opt.sensor_id.empty() ? "kinect_v1" : opt.sensor_id;
+  std::smatch m;
+  const auto stem = fs::path(path).stem().string();
+  if (std::regex_search(stem, m, std::regex("_(p[0-9]+)$"))) rec.metadata["subject"] = m[1].str();
+  auto tags = fs::path(path).replace_extension(".tagstream");
+  if (fs::exists(tags)) {
+    rec.annotations = read_tagstream(tags.string());
+    if (!rec.annotations.empty()) rec.metadata["gesture"] = rec.annotations.front().label;
+  }
+  read_rows(csv, opt, rec, [&](const std::vector<std::string>& f) {
+    expect_fields(csv, f, 81, "time in microseconds, 20 joints x X/Y/Z/W");
+    const auto us = csv.integer(f, 0, "time");
+    bool any = false;
+    for (std::size_t i = 1; i < f.size() && !any; ++i) any = csv.number(f, i, "joint value") != 0.0;
+    if (!any) {  // all zeros: no skeleton in this frame
+      ++rec.report.empty_frames;
+      return;
+    }
+    const auto joint = [&](std::size_t j) {
+      const std::string name = kV1Joints[j];
+      return Eigen::Vector3d(csv.number(f, 1 + 4 * j, name + " x"), csv.number(f, 2 + 4 * j, name + " y"),
+                             csv.number(f, 3 + 4 * j, name + " z"));
+    };
+    skeleton::Skeleton s;
+    s.sensor_id = sensor;
+    s.frame_id = sensor;
+    s.stamp_ns = us * 1000;
+    s.frame_number = rec.frames.size();
+    for (std::size_t i = 0; i < kJointCount; ++i) {
+      s.joints[i].position = joint(kV1Map[i]);
+      s.joints[i].confidence = skeleton::kTracked;  // the format has no tracking state
+    }
+    add_wrists(rec, joint(6), joint(10));
     rec.frames.push_back(std::move(s));
   });
   return rec;
@@ -435,6 +479,7 @@ Recording read_any(Format format, const std::string& path, const ReadOptions& op
     case Format::KinectV2: return read_kinect_v2(path, options);
     case Format::MultiTrack: return read_multitrack(path, options);
     case Format::GesturePhase: return read_gesture_phase(path, options);
+    case Format::Msrc12: return read_msrc12(path, options);
   }
   throw std::invalid_argument("unknown format");
 }
@@ -452,6 +497,23 @@ Recording read_recording(Format format, const std::string& path, const ReadOptio
                         : "no skeleton frames in " + std::to_string(r.lines) + " data rows (nobody tracked)");
   }
   return rec;
+}
+
+std::vector<Annotation> read_tagstream(const std::string& path) {
+  CsvReader csv(path, ';');
+  std::vector<std::string> f;
+  if (!csv.next(f)) csv.fail("empty file; expected the header 'XQPCTick;Tag'");
+  if (f.size() != 2 || f[0] != "XQPCTick" || f[1] != "Tag") csv.fail("expected the header 'XQPCTick;Tag'");
+  std::vector<Annotation> out;
+  while (csv.next(f)) {
+    if (f.size() != 2 || f[1].empty()) csv.fail("expected '<tick>;<gesture name>', got " + std::to_string(f.size()) + " fields");
+    const auto tick = csv.integer(f, 0, "XQPCTick");
+    if (tick < 0) csv.fail("a negative tick");
+    const std::int64_t us = (tick * 1000 + 49875 / 2) / 49875;
+    if (!out.empty() && us * 1000 < out.back().start_ns) csv.fail("ticks go backwards");
+    out.push_back({f[1], us * 1000, us * 1000});
+  }
+  return out;
 }
 
 std::string skipped_summary(const Recording& rec) {

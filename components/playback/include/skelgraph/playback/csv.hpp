@@ -31,8 +31,9 @@ class DataError : public std::runtime_error {
 
 class CsvReader {
  public:
-  // Throws DataError (line 0) if the file cannot be opened.
-  explicit CsvReader(std::string path);
+  // Throws DataError (line 0) if the file cannot be opened. `separator`
+  // ' ': fields are separated by runs of spaces or tabs (MSRC-12).
+  explicit CsvReader(std::string path, char separator = ',');
   // The next non-empty line split into trimmed fields; false at the end.
   // A trailing empty field (a line ending with a comma) is dropped.
   bool next(std::vector<std::string>& fields);
@@ -47,6 +48,7 @@ class CsvReader {
  private:
   std::string path_;
   std::ifstream in_;
+  char separator_ = ',';
   std::size_t line_ = 0;
 };
 

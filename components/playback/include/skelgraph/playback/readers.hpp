@@ -22,6 +22,7 @@ enum class Format {
   KinectV2,     // Kinect v2 body file (laban/): ticks, 25 joints x (X, Y, Z, TrackingState)
   MultiTrack,   // KinectMultiTrack CSV: two Kinect v2 sensors, several people, ", " separated
   GesturePhase, // UCI gesture-phase CSV: 6 points, per-frame phase labels
+  Msrc12,       // MSRC-12: Kinect v1, 20 joints, space-separated, µs; gesture action points in a .tagstream beside it
 };
 const char* format_name(Format f);  // "generic", "kinder-gator", "kinect-v2", "multitrack", "gesture-phase"
 std::optional<Format> format_from_name(std::string_view name);
@@ -38,7 +39,15 @@ struct ReadReport {
   std::size_t skipped = 0;          // bad lines skipped (OnError::Skip)
   std::size_t repeated_stamps = 0;  // frames with the same stamp as the one before (kept)
   std::size_t last_line = 0;        // the file's last line read (where "no frames" is reported)
+  std::size_t empty_frames = 0;     // lines without a skeleton (MSRC-12: all zeros), left out
   std::vector<std::string> problems;  // the first 20 messages of skipped lines
+};
+
+// A labelled moment or span of a recording: an action point (MSRC-12's tags:
+// start_ns == end_ns) or a range, on the frames' clock.
+struct Annotation {
+  std::string label;
+  std::int64_t start_ns = 0, end_ns = 0;
 };
 
 struct Recording {
@@ -51,6 +60,7 @@ struct Recording {
   // has them: "left_wrist", "right_wrist" (Kinect v1 and v2, gesture-phase).
   // Gesture features can use them offline; the skeleton topics do not carry them.
   std::map<std::string, std::vector<Eigen::Vector3d>> extra_joints;
+  std::vector<Annotation> annotations;          // in time order, when the format has them
   ReadReport report;
 };
 
@@ -58,6 +68,12 @@ struct Recording {
 // OnError::Stop, and under either policy when the file gives no skeleton frame
 // at all (empty, header only, every line bad, or nobody tracked).
 Recording read_recording(Format format, const std::string& path, const ReadOptions& options = {});
+
+// MSRC-12's annotation file (FILE.tagstream: a header `XQPCTick;Tag`, then
+// `<tick>;<gesture name>` per instance): action points on the skeleton file's
+// clock (tick -> µs as the data set's load_tagstream.m: (tick * 1000 + 49875 / 2)
+// / 49875). Throws DataError naming file:line.
+std::vector<Annotation> read_tagstream(const std::string& path);
 
 // "FILE: N bad lines skipped (first: ...)" when lines were skipped, else "".
 std::string skipped_summary(const Recording& recording);
