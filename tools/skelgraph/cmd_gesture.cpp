@@ -18,6 +18,7 @@
 #include "skelgraph/gesture/clip_spotting.hpp"
 #include "skelgraph/gesture/dataset.hpp"
 #include "skelgraph/gesture/sim_sessions.hpp"
+#include "skelgraph/gesture/stream_spotting.hpp"
 #include "skelgraph/gesture/spotter.hpp"
 #include "skelgraph/sim/scenario.hpp"
 
@@ -57,6 +58,8 @@ struct GestureOptions {
   std::vector<std::string> sweep_covariance, sweep_init;
   bool sweep = false;
   bool nested = false;
+  bool spot_streams = false;  // cv --spot: annotated continuous streams (MSRC-12), leave-subject-out spotting
+  StreamSpotOptions stream;
   // sim
   int train_sessions = kTrainSessions, test_sessions = 4;
   double test_noise_scale = 1.0;  // gesture sim: the test sessions' tracker noise
@@ -188,7 +191,57 @@ CvRun run_cv(const GestureOptions& o, const ClassMap& map, const std::vector<Cli
   return {c, evaluate(results, map.classes), results};
 }
 
+// cv --spot: annotated streams, leave-subject-out, a sliding-window spotter (stream_spotting.hpp).
+int gesture_cv_streams(const GestureOptions& o) {
+  auto c = classifier_options(o);
+  c.trimmed = false;  // windows are classified whole
+  const auto format = *playback::format_from_name(o.format);
+  BadInputs bad;
+  std::vector<AnnotatedStream> streams;
+  const auto files = expand_paths(o.inputs);
+  for (const auto& file : files) {
+    bad.guard([&] {
+      const auto rec = playback::read_recording(format, file, read_options(o));
+      note_skipped(rec);
+      try {
+        streams.push_back(annotated_stream(rec, c.features));
+      } catch (const ModelError& e) {
+        throw UsageError(e.what());
+      }
+    });
+  }
+  std::size_t tags = 0;
+  for (const auto& s : streams) tags += s.annotations.size();
+  std::fprintf(stderr, "read %zu annotated streams (%zu action points)\n", streams.size(), tags);
+  if (streams.empty()) throw UsageError("no annotated stream among the inputs");
+  Progress progress;
+  StreamSpotting r;
+  try {
+    r = cross_validate_streams(streams, c, o.stream, [&](int done, int total) {
+      progress("held-out subject " + std::to_string(done) + "/" + std::to_string(total), done == total);
+    });
+  } catch (const ModelError& e) {
+    throw UsageError(std::string("gesture cv --spot: ") + e.what());
+  }
+  if (o.json) {
+    auto j = r.to_json();
+    j["config"] = config_json(c);
+    j["spotting"] = o.stream.to_json();
+    std::printf("%s\n", j.dump(2).c_str());
+  } else {
+    std::printf("leave-subject-out spotting in %zu annotated streams of %zu subjects (a %.1f s window every %.1f s, %d in a "
+                "row; an event within %.1f s of an action point matches it):\n",
+                r.streams, r.subjects.size(), o.stream.window_s, o.stream.step_s, o.stream.confirm, o.stream.slack_s);
+    for (const auto& k : r.per_class)
+      std::printf("  %-28s %3d tagged, %3d events: precision %.3f recall %.3f F1 %.3f; latency median %+.0f ms\n",
+                  ("'" + k.label + "'").c_str(), k.truth, k.events, k.precision, k.recall, k.f1, 1e3 * k.median_latency_s);
+    std::printf("macro F1 %.3f; events a median %+.0f ms after the action point\n", r.macro_f1, 1e3 * r.median_latency_s);
+  }
+  return bad.exit_code(0, files.size());
+}
+
 int gesture_cv(const GestureOptions& o) {
+  if (o.spot_streams) return gesture_cv_streams(o);
   const auto map = class_map(o.classes);
   const auto base = classifier_options(o);
   BadInputs bad;
@@ -662,6 +715,18 @@ void add_gesture_command(CLI::App& app, GlobalOptions&, Action& run) {
 
   auto* cv = g->add_subcommand("cv", "Cross-validate: confusion matrix, accuracy, per-class precision/recall/F1, ROC");
   add_common(cv, *o, true);
+  cv->add_flag("--spot", o->spot_streams,
+              "the inputs are annotated continuous streams (--format msrc12: a .tagstream beside each file): leave one "
+              "subject out, spot with a sliding window, score events against the action points (per class P/R/F1, "
+              "macro F1, latency); --features defaults to body here");
+  cv->add_option("--window-model", o->stream.model, "--spot: the window classifier, knn (default) or hmm (the --states ... options)")
+      ->check(CLI::IsMember({"hmm", "knn"}));
+  cv->add_option("--knn-k", o->stream.knn_k, "--spot --window-model knn: neighbours (default 5)")->check(CLI::Range(1, 100));
+  cv->add_option("--window", o->stream.window_s, "--spot: s the classifier looks back (default 1.0)")->check(CLI::Range(0.2, 10.0));
+  cv->add_option("--step", o->stream.step_s, "--spot: s between windows (default 0.1)")->check(CLI::Range(0.01, 2.0));
+  cv->add_option("--confirm", o->stream.confirm, "--spot: windows in a row one gesture must win (default 2)")->check(CLI::Range(1, 50));
+  cv->add_option("--refractory", o->stream.refractory_s, "--spot: s without another event of the same class (default 1.5)")
+      ->check(CLI::Range(0.0, 30.0));
   cv->add_option("--split", o->split, "lso: leave one subject out (default); kfold: stratified k-fold")
       ->check(CLI::IsMember({"lso", "kfold"}));
   cv->add_option("--folds", o->folds, "k for --split kfold (default 5)")->check(CLI::Range(2, 1000));
@@ -677,7 +742,11 @@ void add_gesture_command(CLI::App& app, GlobalOptions&, Action& run) {
       ->check(CLI::IsMember({"full", "diag"}));
   cv->add_option("--sweep-init", o->sweep_init, "initialisations to try (default: --init's)")
       ->check(CLI::IsMember({"segments", "kmeans"}));
-  cv->callback([o, &run] { run = [o] { return gesture_cv(*o); }; });
+  cv->callback([o, cv, &run] {
+    // --spot's defaults are its best measured configuration (docs/experiments/2026-12-04-msrc12-spotting.md).
+    if (o->spot_streams && cv->get_option("--features")->count() == 0) o->features = "body";
+    run = [o] { return gesture_cv(*o); };
+  });
 
   auto* f = g->add_subcommand("features", "Print the per-frame features of recordings as CSV (what the models see)");
   add_common(f, *o, false);

@@ -186,6 +186,9 @@ std::vector<int> mirror_permutation(FeatureSet set) {
 
 Sequence mirrored(const Sequence& x, FeatureSet set) {
   const auto perm = mirror_permutation(set);
+  if (static_cast<std::size_t>(x.cols()) != perm.size())
+    throw ModelError("features have " + std::to_string(x.cols()) + " columns; the '" + feature_set_name(set) + "' set has " +
+                     std::to_string(perm.size()));
   Sequence out(x.rows(), x.cols());
   for (std::size_t i = 0; i < perm.size(); ++i) out.col(static_cast<Eigen::Index>(i)) = x.col(perm[i]);
   return out;
@@ -194,6 +197,9 @@ Sequence mirrored(const Sequence& x, FeatureSet set) {
 Sequence right_handed(const Sequence& x, FeatureSet set, bool* was) {
   const auto names = feature_names(set);
   const Layout l = layout(set);
+  if (static_cast<std::size_t>(x.cols()) < l.values.size())
+    throw ModelError("features have " + std::to_string(x.cols()) + " columns; the '" + feature_set_name(set) + "' set has " +
+                     std::to_string(names.size()));
   double side[2] = {0, 0};
   if (x.rows() > 1)
     for (std::size_t i = 0; i < l.values.size(); ++i) {

@@ -1,0 +1,99 @@
+#pragma once
+// Gestures in continuous annotated recordings (MSRC-12: each instance tagged
+// at one action point): a classifier over a sliding window of the last
+// `window_s`, trained on windows that end around the action points (the
+// gesture's class) and windows that end away from every one (garbage);
+// spotting fires an event when a gesture class wins `confirm` windows in a
+// row, then stays quiet on that class for `refractory_s`. Scored against the
+// action points (an event within `slack_s` of one matches it; latency =
+// event - action point), per class and as a macro F1, leave-subject-out.
+// Windows end at the newest frame, so the same runs live. No DDS.
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "skelgraph/gesture/classifier.hpp"
+#include "skelgraph/gesture/spotter.hpp"
+#include "skelgraph/playback/readers.hpp"
+
+namespace skelgraph::gesture {
+
+struct AnnotatedStream {
+  std::string source, subject;
+  std::vector<std::int64_t> stamps;  // per frame
+  Sequence x;                        // features per frame
+  std::vector<playback::Annotation> annotations;
+};
+
+// A recording with annotations (e.g. MSRC-12 with its .tagstream) as a stream
+// of features; a ModelError when the recording has no annotations or the
+// feature set needs wrists it lacks. Subject: the recording's "subject"
+// metadata, else the file name.
+AnnotatedStream annotated_stream(const playback::Recording& recording, const FeatureOptions& features);
+
+struct StreamSpotOptions {
+  double window_s = 1.0;                                    // what the classifier sees
+  std::vector<double> positive_offsets_s{-0.1, 0.0, 0.1, 0.2};  // training windows end this far from an action point
+  double negative_gap_s = 0.8;                              // garbage windows end at least this far from every one
+  double negative_step_s = 0.3;                             // ... one every this long
+  double step_s = 0.1;                                      // spotting: a window every this long
+  int confirm = 2;                                          // the same gesture class wins this many windows in a row
+  double refractory_s = 1.5;                                // then no event of that class for this long
+  double slack_s = 0.5;                                     // scoring: an event this close to an action point matches it
+  // The window classifier: "knn" (each window resampled to `knn_samples`
+  // frames and standardised; the majority of its `knn_k` nearest training
+  // windows; as the windows come, no mirroring) or "hmm" (the Classifier,
+  // one HMM per class). knn measured best on MSRC-12 (macro F1 0.65 against
+  // 0.14-0.33).
+  std::string model = "knn";
+  int knn_k = 5, knn_samples = 10;
+  nlohmann::json to_json() const;
+};
+
+// k nearest neighbours over resampled, standardised windows (StreamSpotOptions::model "knn").
+class WindowKnn {
+ public:
+  WindowKnn(const std::vector<Clip>& clips, const ClassMap& map, int k, int samples);
+  Decision classify(const Sequence& x) const;
+  int garbage_index() const { return garbage_; }
+  const std::vector<std::string>& labels() const { return labels_; }
+
+ private:
+  Eigen::VectorXd vec(const Sequence& x) const;
+  std::vector<std::string> labels_;
+  int garbage_ = -1, k_, samples_;
+  Eigen::VectorXd mean_, scale_;
+  Eigen::MatrixXd train_;  // one standardised window per column
+  std::vector<int> label_;
+};
+
+// The classes of the streams' annotations (sorted), with "none" as garbage.
+ClassMap stream_class_map(const std::vector<AnnotatedStream>& streams);
+// Training windows of one stream (Clip.subject = the stream's).
+std::vector<Clip> stream_windows(const AnnotatedStream& s, const ClassMap& map, const StreamSpotOptions& o);
+// Events over a whole stream, as they would go out live.
+std::vector<SpottedEvent> spot_stream(const Classifier& c, const AnnotatedStream& s, const StreamSpotOptions& o);
+std::vector<SpottedEvent> spot_stream(const WindowKnn& c, const AnnotatedStream& s, const StreamSpotOptions& o);
+// The stream's action points as truth to score events against.
+std::vector<TruthGesture> stream_truth(const AnnotatedStream& s);
+
+struct StreamSpotting {
+  std::vector<std::string> classes;         // the gestures (garbage left out)
+  std::vector<SpottingReport> per_class;    // pooled over every held-out stream
+  double macro_f1 = 0.0;                    // mean of the classes' F1
+  double median_latency_s = 0.0;            // over every matched event: event - action point
+  std::size_t streams = 0, windows = 0;
+  std::vector<std::string> subjects;
+  nlohmann::json to_json() const;
+};
+
+// Leave-subject-out: for each subject, a classifier trained on the others'
+// windows spots in that subject's streams.
+StreamSpotting cross_validate_streams(const std::vector<AnnotatedStream>& streams, const ClassifierOptions& c,
+                                      const StreamSpotOptions& o,
+                                      const std::function<void(int done, int total)>& progress = {});
+
+}  // namespace skelgraph::gesture

@@ -1,0 +1,238 @@
+#include "skelgraph/gesture/stream_spotting.hpp"
+
+#include <algorithm>
+#include <filesystem>
+#include <map>
+#include <set>
+
+#include "skelgraph/gesture/dataset.hpp"
+
+namespace skelgraph::gesture {
+
+namespace {
+
+std::int64_t ns(double s) { return static_cast<std::int64_t>(s * 1e9); }
+
+// The frames of the window that ends at frame `end` (inclusive): those newer than stamp[end] - window.
+Sequence window_at(const AnnotatedStream& s, std::size_t end, double window_s) {
+  const auto from = s.stamps[end] - ns(window_s);
+  std::size_t begin = end;
+  while (begin > 0 && s.stamps[begin - 1] > from) --begin;
+  return s.x.middleRows(static_cast<Eigen::Index>(begin), static_cast<Eigen::Index>(end - begin + 1));
+}
+
+// The last frame at or before t; false when t is before the first frame.
+bool frame_at(const AnnotatedStream& s, std::int64_t t, std::size_t& out) {
+  const auto it = std::upper_bound(s.stamps.begin(), s.stamps.end(), t);
+  if (it == s.stamps.begin()) return false;
+  out = static_cast<std::size_t>(it - s.stamps.begin()) - 1;
+  return true;
+}
+
+}  // namespace
+
+nlohmann::json StreamSpotOptions::to_json() const {
+  return {{"window_s", window_s},         {"positive_offsets_s", positive_offsets_s}, {"negative_gap_s", negative_gap_s},
+          {"negative_step_s", negative_step_s}, {"step_s", step_s},                    {"confirm", confirm},
+          {"refractory_s", refractory_s}, {"slack_s", slack_s}, {"model", model}, {"knn_k", knn_k},
+          {"knn_samples", knn_samples}};
+}
+
+AnnotatedStream annotated_stream(const playback::Recording& rec, const FeatureOptions& features) {
+  if (rec.annotations.empty())
+    throw ModelError(rec.source + ": no annotations (MSRC-12: a .tagstream file beside it)");
+  AnnotatedStream s;
+  s.source = rec.source;
+  const auto it = rec.metadata.find("subject");
+  s.subject = it != rec.metadata.end() ? it->second : std::filesystem::path(rec.source).stem().string();
+  for (const auto& f : rec.frames) s.stamps.push_back(f.stamp_ns);
+  s.x = recording_features(rec, features).x;
+  s.annotations = rec.annotations;
+  return s;
+}
+
+ClassMap stream_class_map(const std::vector<AnnotatedStream>& streams) {
+  std::set<std::string> labels;
+  for (const auto& s : streams)
+    for (const auto& a : s.annotations) labels.insert(a.label);
+  ClassMap m;
+  for (const auto& l : labels) {
+    m.classes.push_back(l);
+    m.action_class[l] = l;
+  }
+  m.garbage = "none";
+  m.classes.push_back(m.garbage);
+  m.action_class[m.garbage] = m.garbage;
+  return m;
+}
+
+std::vector<Clip> stream_windows(const AnnotatedStream& s, const ClassMap& map, const StreamSpotOptions& o) {
+  std::vector<Clip> clips;
+  if (s.stamps.empty()) return clips;
+  const auto add = [&](std::int64_t t, const std::string& action) {
+    std::size_t end = 0;
+    if (!frame_at(s, t, end) || s.stamps[end] - s.stamps.front() < ns(0.5 * o.window_s)) return;
+    Clip c;
+    c.source = s.source;
+    c.subject = s.subject;
+    c.action = action;
+    c.label = map.label_of(action).value_or(-1);
+    c.x = window_at(s, end, o.window_s);
+    if (c.x.rows() >= 3) clips.push_back(std::move(c));
+  };
+  for (const auto& a : s.annotations)
+    for (double d : o.positive_offsets_s) add(a.start_ns + ns(d), a.label);
+  for (auto t = s.stamps.front() + ns(o.window_s); t <= s.stamps.back(); t += ns(o.negative_step_s)) {
+    bool near = false;
+    for (const auto& a : s.annotations) near = near || std::llabs(t - a.start_ns) < ns(o.negative_gap_s);
+    if (!near) add(t, map.garbage);
+  }
+  return clips;
+}
+
+WindowKnn::WindowKnn(const std::vector<Clip>& clips, const ClassMap& map, int k, int samples)
+    : labels_(map.classes), garbage_(map.garbage_index()), k_(k), samples_(samples) {
+  std::vector<const Clip*> use;
+  for (const auto& c : clips)
+    if (c.label >= 0 && c.x.rows() > 0) use.push_back(&c);
+  if (use.empty()) throw ModelError("knn: no labelled training windows");
+  const auto dim = static_cast<Eigen::Index>(use.front()->x.cols()) * samples_;
+  Eigen::MatrixXd raw(dim, static_cast<Eigen::Index>(use.size()));
+  mean_ = Eigen::VectorXd::Zero(dim);
+  scale_ = Eigen::VectorXd::Ones(dim);
+  for (std::size_t i = 0; i < use.size(); ++i) {
+    raw.col(static_cast<Eigen::Index>(i)) = vec(use[i]->x);
+    label_.push_back(use[i]->label);
+  }
+  mean_ = raw.rowwise().mean();
+  const Eigen::MatrixXd centred = raw.colwise() - mean_;
+  scale_ = (centred.array().square().rowwise().sum() / static_cast<double>(use.size())).sqrt().max(1e-6).matrix();
+  train_ = centred.array().colwise() / scale_.array();
+}
+
+Eigen::VectorXd WindowKnn::vec(const Sequence& x) const {  // `samples_` rows, evenly over the window, stacked
+  Eigen::VectorXd v(x.cols() * samples_);
+  for (int i = 0; i < samples_; ++i) {
+    const double at = samples_ == 1 ? 0.0 : static_cast<double>(i) * static_cast<double>(x.rows() - 1) / (samples_ - 1);
+    const auto a = static_cast<Eigen::Index>(std::floor(at));
+    const auto b = std::min<Eigen::Index>(a + 1, x.rows() - 1);
+    const double u = at - static_cast<double>(a);
+    v.segment(i * x.cols(), x.cols()) = ((1 - u) * x.row(a) + u * x.row(b)).transpose();
+  }
+  return v;
+}
+
+Decision WindowKnn::classify(const Sequence& x) const {
+  const Eigen::VectorXd q = ((vec(x) - mean_).array() / scale_.array()).matrix();
+  const Eigen::VectorXd d2 = (train_.colwise() - q).colwise().squaredNorm().transpose();
+  std::vector<Eigen::Index> idx(static_cast<std::size_t>(d2.size()));
+  for (Eigen::Index i = 0; i < d2.size(); ++i) idx[static_cast<std::size_t>(i)] = i;
+  const auto k = std::min<std::size_t>(static_cast<std::size_t>(k_), idx.size());
+  std::partial_sort(idx.begin(), idx.begin() + static_cast<std::ptrdiff_t>(k), idx.end(),
+                    [&](Eigen::Index a, Eigen::Index b) { return d2(a) < d2(b); });
+  Decision d;
+  d.scores.assign(labels_.size(), 0.0);
+  for (std::size_t i = 0; i < k; ++i) d.scores[static_cast<std::size_t>(label_[static_cast<std::size_t>(idx[i])])] += 1.0;
+  d.label = static_cast<int>(std::max_element(d.scores.begin(), d.scores.end()) - d.scores.begin());
+  auto sorted = d.scores;
+  std::sort(sorted.rbegin(), sorted.rend());
+  d.margin = sorted.size() > 1 ? sorted[0] - sorted[1] : sorted[0];
+  return d;
+}
+
+namespace {
+template <class Model>
+std::vector<SpottedEvent> spot_with(const Model& c, const AnnotatedStream& s, const StreamSpotOptions& o) {
+  std::vector<SpottedEvent> events;
+  if (s.stamps.empty()) return events;
+  int last = -1, run = 0;
+  std::map<int, std::int64_t> quiet_until;
+  for (auto t = s.stamps.front() + ns(o.window_s); t <= s.stamps.back(); t += ns(o.step_s)) {
+    std::size_t end = 0;
+    if (!frame_at(s, t, end)) continue;
+    const auto x = window_at(s, end, o.window_s);
+    if (x.rows() < 3) continue;
+    const auto d = c.classify(x);
+    const bool gesture = !d.rejected && d.label != c.garbage_index();
+    run = gesture && d.label == last ? run + 1 : gesture ? 1 : 0;
+    last = gesture ? d.label : -1;
+    if (!gesture || run < o.confirm) continue;
+    const auto now = s.stamps[end];
+    if (now < quiet_until[d.label]) continue;
+    quiet_until[d.label] = now + ns(o.refractory_s);
+    SpottedEvent e;
+    e.label = c.labels()[static_cast<std::size_t>(d.label)];
+    e.start_ns = now - ns(o.window_s);
+    e.end_ns = now;
+    e.log_likelihood = d.scores[static_cast<std::size_t>(d.label)];
+    e.confidence = 1.0 - std::exp(-d.margin);
+    events.push_back(e);
+  }
+  return events;
+}
+}  // namespace
+
+std::vector<SpottedEvent> spot_stream(const Classifier& c, const AnnotatedStream& s, const StreamSpotOptions& o) {
+  return spot_with(c, s, o);
+}
+std::vector<SpottedEvent> spot_stream(const WindowKnn& c, const AnnotatedStream& s, const StreamSpotOptions& o) {
+  return spot_with(c, s, o);
+}
+
+std::vector<TruthGesture> stream_truth(const AnnotatedStream& s) {
+  std::vector<TruthGesture> t;
+  for (const auto& a : s.annotations) t.push_back({a.label, a.start_ns, a.end_ns});
+  return t;
+}
+
+nlohmann::json StreamSpotting::to_json() const {
+  nlohmann::json per = nlohmann::json::array();
+  for (const auto& r : per_class) per.push_back(gesture::to_json(r));
+  return {{"classes", classes},          {"per_class", per},  {"macro_f1", macro_f1},
+          {"median_latency_s", median_latency_s}, {"streams", streams}, {"training_windows", windows},
+          {"subjects", subjects}};
+}
+
+StreamSpotting cross_validate_streams(const std::vector<AnnotatedStream>& streams, const ClassifierOptions& c,
+                                      const StreamSpotOptions& o, const std::function<void(int, int)>& progress) {
+  const auto map = stream_class_map(streams);
+  StreamSpotting out;
+  for (const auto& k : map.classes)
+    if (k != map.garbage) out.classes.push_back(k);
+  std::set<std::string> subjects;
+  for (const auto& s : streams) subjects.insert(s.subject);
+  out.subjects.assign(subjects.begin(), subjects.end());
+  if (subjects.size() < 2) throw ModelError("leave-subject-out needs streams of at least two subjects");
+  std::vector<std::vector<Clip>> windows;
+  for (const auto& s : streams) windows.push_back(stream_windows(s, map, o));
+  std::map<std::string, std::vector<SpottingReport>> reports;
+  int done = 0;
+  for (const auto& held : out.subjects) {
+    std::vector<Clip> train;
+    for (std::size_t i = 0; i < streams.size(); ++i)
+      if (streams[i].subject != held) train.insert(train.end(), windows[i].begin(), windows[i].end());
+    out.windows += train.size();
+    std::optional<Classifier> hmm;
+    std::optional<WindowKnn> knn;
+    if (o.model == "knn") knn.emplace(train, map, o.knn_k, o.knn_samples);
+    else hmm = Classifier::train(train, map, c);
+    for (const auto& s : streams) {
+      if (s.subject != held) continue;
+      const auto events = knn ? spot_stream(*knn, s, o) : spot_stream(*hmm, s, o);
+      const auto truth = stream_truth(s);
+      for (const auto& k : out.classes) reports[k].push_back(score_spotting(events, truth, k, o.slack_s));
+      ++out.streams;
+    }
+    if (progress) progress(++done, static_cast<int>(out.subjects.size()));
+  }
+  std::vector<double> latencies;
+  for (const auto& k : out.classes) {
+    out.per_class.push_back(combine(reports[k]));
+    out.macro_f1 += out.per_class.back().f1 / static_cast<double>(out.classes.size());
+    latencies.insert(latencies.end(), out.per_class.back().latency_s.begin(), out.per_class.back().latency_s.end());
+  }
+  out.median_latency_s = median(latencies);
+  return out;
+}
+
+}  // namespace skelgraph::gesture
