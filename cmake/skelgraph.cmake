@@ -67,3 +67,23 @@ function(skelgraph_next_domain out)
   set_property(GLOBAL PROPERTY SKELGRAPH_NEXT_TEST_DOMAIN ${next})
   set(${out} ${d} PARENT_SCOPE)
 endfunction()
+
+# skelgraph_npm_ci(DIR PACKAGE_DIR STAMP_PACKAGE COMMENT OUT_STAMP): npm packages
+# a build step needs, installed by `npm ci` from PACKAGE_DIR's package.json and
+# package-lock.json into DIR (once; again when the lock file changes).
+# OUT_STAMP: the installed STAMP_PACKAGE's package.json, to depend on.
+function(skelgraph_npm_ci dir package_dir stamp_package comment out_stamp)
+  find_program(NPM npm)
+  if(NOT NPM)
+    message(FATAL_ERROR "npm not found: ${comment} (Debian: apt install npm; tools/run installs it)")
+  endif()
+  set(stamp ${dir}/node_modules/${stamp_package}/package.json)
+  add_custom_command(OUTPUT ${stamp}
+    COMMAND ${CMAKE_COMMAND} -E make_directory ${dir}
+    COMMAND ${CMAKE_COMMAND} -E copy ${package_dir}/package.json ${package_dir}/package-lock.json ${dir}
+    COMMAND ${NPM} ci --prefix ${dir} --no-audit --no-fund --loglevel=error
+    COMMAND ${CMAKE_COMMAND} -E touch ${stamp}
+    DEPENDS ${package_dir}/package.json ${package_dir}/package-lock.json
+    COMMENT "${comment}")
+  set(${out_stamp} ${stamp} PARENT_SCOPE)
+endfunction()

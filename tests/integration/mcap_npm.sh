@@ -17,7 +17,7 @@ SKELGRAPH=${3:?}
 WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
 # The scripts are run from the install directory, next to their packages.
-cp "$(dirname "$0")/../npm/check_mcap.mjs" "$(dirname "$0")/../npm/mcap_matrix.mjs" "$NPM_DIR/"
+cp "$(dirname "$0")"/../npm/*.mjs "$NPM_DIR/"
 for c in none lz4 zstd; do
   "$SAMPLES" "$WORK/$c.mcap" "$WORK/$c.jsonl" "$c"
   node "$NPM_DIR/check_mcap.mjs" "$WORK/$c.mcap" "$WORK/$c.jsonl" >"$WORK/$c.json"

@@ -7,24 +7,18 @@
 //   very same bytes.
 // Usage: node check_mcap.mjs FILE.mcap EXPECTED.jsonl   (prints a JSON summary)
 import fs from "node:fs";
-import { McapIndexedReader, McapStreamReader } from "@mcap/core";
+import { McapStreamReader } from "@mcap/core";
 import { parseIDL } from "@foxglove/omgidl-parser";
 import { MessageReader, MessageWriter } from "@foxglove/omgidl-serialization";
-import zstd from "@foxglove/wasm-zstd";
-import lz4 from "@foxglove/wasm-lz4";
+import { decompressHandlers, openIndexed } from "./mcap_open.mjs";
 
 const [file, expectedPath] = process.argv.slice(2);
 const fail = (msg) => {
   console.error(`FAIL: ${msg}`);
   process.exit(1);
 };
-await zstd.isLoaded;
-await lz4.isLoaded;
-const decompressHandlers = {
-  zstd: (buf, size) => zstd.decompress(buf, Number(size)),
-  lz4: (buf, size) => lz4(buf, Number(size)),
-};
-const bytes = new Uint8Array(fs.readFileSync(file));
+
+const { bytes, reader } = await openIndexed(file);
 
 // 1. Every record, in file order, CRCs checked.
 const stream = new McapStreamReader({ decompressHandlers, validateCrcs: true });
@@ -37,12 +31,7 @@ for (let r; (r = stream.nextRecord()); ) {
 }
 if (!stream.done()) fail("the stream reader did not reach the end of the file");
 
-// 2. Through the index.
-const readable = {
-  size: async () => BigInt(bytes.length),
-  read: async (offset, size) => bytes.subarray(Number(offset), Number(offset + size)),
-};
-const reader = await McapIndexedReader.Initialize({ readable, decompressHandlers });
+// 2. Through the index (opened above).
 const expected = fs.readFileSync(expectedPath, "utf8").trim().split("\n").map((l) => JSON.parse(l));
 if (reader.statistics === undefined) fail("no statistics record");
 if (Number(reader.statistics.messageCount) !== expected.length) {

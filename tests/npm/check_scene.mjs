@@ -15,14 +15,11 @@
 // live: written by the recorder as samples arrived (receive times from several
 // DDS threads, a few microseconds out of order): the entity count per tick may
 // be off by 1 %.
-import fs from "node:fs";
 import path from "node:path";
 import { createRequire } from "node:module";
-import { McapIndexedReader } from "@mcap/core";
 import { parseIDL } from "@foxglove/omgidl-parser";
 import { MessageReader, MessageWriter } from "@foxglove/omgidl-serialization";
-import zstd from "@foxglove/wasm-zstd";
-import lz4 from "@foxglove/wasm-lz4";
+import { openIndexed } from "./mcap_open.mjs";
 
 const [file, writeIdl, mode] = process.argv.slice(2);
 const fail = (msg) => {
@@ -32,18 +29,7 @@ const fail = (msg) => {
 const require = createRequire(import.meta.url);
 const { flattenedIdl } = require(path.resolve(writeIdl));
 const modules = path.join(path.dirname(new URL(import.meta.url).pathname), "node_modules");
-await zstd.isLoaded;
-await lz4.isLoaded;
-const decompressHandlers = {
-  zstd: (buf, size) => zstd.decompress(buf, Number(size)),
-  lz4: (buf, size) => lz4(buf, Number(size)),
-};
-const bytes = new Uint8Array(fs.readFileSync(file));
-const readable = {
-  size: async () => BigInt(bytes.length),
-  read: async (offset, size) => bytes.subarray(Number(offset), Number(offset + size)),
-};
-const reader = await McapIndexedReader.Initialize({ readable, decompressHandlers });
+const { reader } = await openIndexed(file);
 
 const codecs = new Map();
 function codec(schema) {
