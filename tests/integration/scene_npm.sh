@@ -32,10 +32,10 @@ ok "the demo's scene: $(cat "$WORK/demo_scene.json")"
 "$SAMPLES" "$WORK/samples.mcap" "$WORK/samples.jsonl" zstd
 "$S" bag export --scene "$WORK/samples.mcap" --out "$WORK/samples_scene.mcap" --json >"$WORK/samples_export.json" \
   || fail "bag export --scene of the samples"
-json_check "$WORK/samples_export.json" 'd["pointing"] == 1 and d["robot_states"] == 1 and d["undecodable"] == 0 and d["copied"] > 10'
+json_check "$WORK/samples_export.json" 'd["pointing"] == 1 and d["robot_states"] == 1 and d["safety"] == 1 and d["undecodable"] == 0 and d["copied"] > 10'
 check "$WORK/samples_scene.mcap" "$WORK/samples_scene.json"
-json_check "$WORK/samples_scene.json" 'd["byKind"]["pointing"] == 1 and d["byKind"]["robot"] == 1 and d["byKind"]["raw"] >= 1'
-ok "pointing and the robot as entities: $(cat "$WORK/samples_scene.json")"
+json_check "$WORK/samples_scene.json" 'd["byKind"]["pointing"] == 1 and d["byKind"]["robot"] == 1 and d["byKind"]["safety"] == 1 and d["byKind"]["raw"] >= 1'
+ok "pointing, the robot and its safety verdict as entities: $(cat "$WORK/samples_scene.json")"
 
 # 3. Real data sets, imported and exported with the scene.
 kg=$(ls "$DATA"/kinder-gator/adults/*Point-at-the-camera*.csv | head -1)

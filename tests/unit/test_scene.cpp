@@ -138,6 +138,28 @@ TEST(Scene, PointingAndTheRobotAreDrawnWhereTheyAre) {
   EXPECT_NEAR(re->cylinders[0].size.z(), 0.5, 1e-12);
   EXPECT_EQ(re->spheres.size(), 2u);
   EXPECT_EQ(re->metadata.at(1).second, "true");  // stopped
+  // The monitor's verdict colours the robot and labels it above its base.
+  SceneBuilder b2;
+  b2.add_robot("robot1", {c}, false, 100);
+  Safety s;
+  s.robot_id = "robot1";
+  s.state = SafetyState::Reduced;
+  s.speed_scale = 0.3;
+  s.separation_m = 0.92;
+  s.person_id = 3;
+  s.body_part = "left_hand";
+  b2.add_safety(s, 200);
+  b2.add_robot("robot1", {c}, false, 300);
+  const auto es2 = entities(b2.finish());
+  const auto* label = find(es2, "safety/robot1");
+  ASSERT_NE(label, nullptr);
+  ASSERT_EQ(label->texts.size(), 1u);
+  EXPECT_EQ(label->texts[0].text, "reduced, speed 30 %: person 3's left_hand 0.92 m away");
+  EXPECT_TRUE(label->texts[0].pose.position.isApprox(Vector3d(0, 2.3, 0)));
+  const auto* amber = find(es2, "robot/robot1");  // the one after the verdict
+  ASSERT_NE(amber, nullptr);
+  EXPECT_EQ(amber->cylinders[0].color.r, 1.0);
+  EXPECT_EQ(amber->cylinders[0].color.g, 0.7);
 }
 
 TEST(Scene, TransformCdrIsLaidOutAsTheSchemaSays) {

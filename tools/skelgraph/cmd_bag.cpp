@@ -249,6 +249,7 @@ int export_scene(const std::string& file, const std::string& out, const std::str
                                        {"poses", r.poses},
                                        {"pointing", r.pointing},
                                        {"robot_states", r.robot_states},
+                                       {"safety", r.safety},
                                        {"scene_updates", r.updates},
                                        {"entities", r.entities},
                                        {"transforms", r.transforms},

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 
 namespace skelgraph::scene {
 
@@ -227,7 +228,13 @@ void SceneBuilder::add_robot(const std::string& robot_id, const std::vector<Caps
   e.id = "robot/" + robot_id;
   e.lifetime_ns = ns(o_.lifetime_s);
   e.metadata = {{"robot", robot_id}, {"protective_stop", stopped ? "true" : "false"}};
-  const Color c = stopped ? Color{0.9, 0.15, 0.1, 0.85} : Color{0.6, 0.62, 0.66, 0.85};
+  const auto verdict = safety_.find(robot_id);
+  const auto state = stopped ? SafetyState::ProtectiveStop : verdict == safety_.end() ? SafetyState::Run : verdict->second;
+  const Color c = state == SafetyState::ProtectiveStop ? Color{0.9, 0.15, 0.1, 0.85}
+                  : state == SafetyState::Reduced      ? Color{1.0, 0.7, 0.1, 0.85}
+                  : verdict != safety_.end()           ? Color{0.2, 0.75, 0.3, 0.85}
+                                                       : Color{0.6, 0.62, 0.66, 0.85};
+  if (!capsules.empty()) robot_base_[robot_id] = capsules.front().a;
   for (const auto& k : capsules) {
     const Eigen::Vector3d axis = k.b - k.a;
     Cylinder y;
@@ -244,6 +251,35 @@ void SceneBuilder::add_robot(const std::string& robot_id, const std::vector<Caps
       e.spheres.push_back(s);
     }
   }
+  put(std::move(e));
+}
+
+void SceneBuilder::add_safety(const Safety& s, std::int64_t log_ns) {
+  advance(log_ns);
+  safety_[s.robot_id] = s.state;
+  Entity e;
+  e.stamp_ns = log_ns;
+  e.frame_id = "world";
+  e.id = "safety/" + s.robot_id;
+  e.lifetime_ns = ns(o_.event_lifetime_s);
+  const char* name = s.state == SafetyState::Run ? "run" : s.state == SafetyState::Reduced ? "reduced" : "protective stop";
+  e.metadata = {{"robot", s.robot_id}, {"state", name}, {"speed_scale", std::to_string(s.speed_scale)},
+                {"separation_m", std::to_string(s.separation_m)}, {"reason", s.reason}};
+  Text t;
+  const auto base = robot_base_.find(s.robot_id);
+  t.pose.position = (base != robot_base_.end() ? base->second : Eigen::Vector3d::Zero()) + Eigen::Vector3d(0, 1.3, 0);
+  t.font_size = 0.12;
+  t.color = s.state == SafetyState::Run ? Color{0.2, 0.75, 0.3, 1} : s.state == SafetyState::Reduced ? Color{1.0, 0.7, 0.1, 1}
+                                                                                                    : Color{0.9, 0.15, 0.1, 1};
+  char text[160];
+  if (s.separation_m >= 0)
+    std::snprintf(text, sizeof text, "%s, speed %.0f %%: person %u's %s %.2f m away", name, 100 * s.speed_scale, s.person_id,
+                  s.body_part.c_str(), s.separation_m);
+  else
+    std::snprintf(text, sizeof text, "%s, speed %.0f %%: nobody near", name, 100 * s.speed_scale);
+  t.text = text;
+  if (s.state != SafetyState::Run && !s.reason.empty()) t.text += "\n" + s.reason;
+  e.texts.push_back(std::move(t));
   put(std::move(e));
 }
 

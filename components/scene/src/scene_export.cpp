@@ -80,6 +80,20 @@ void SceneTap::add(mcap::Writer& w, const std::string& topic, const std::string&
       for (const auto& c : s.capsules()) caps.push_back({vec(c.a()), vec(c.b()), c.radius(), c.name().to_string()});
       scene_.add_robot(s.robot_id().to_string(), caps, s.protective_stop(), log_ns);
       ++r_.robot_states;
+    } else if (topic == runtime::topics::kSafety.name && type_name == msg::MessageTraits<msg::SafetyStatus>::name) {
+      const auto m = msg::from_cdr<msg::SafetyStatus>(data, size);
+      Safety s;
+      s.robot_id = m.robot_id().to_string();
+      s.state = m.state() == msg::SAFETY_PROTECTIVE_STOP ? SafetyState::ProtectiveStop
+                : m.state() == msg::SAFETY_REDUCED       ? SafetyState::Reduced
+                                                         : SafetyState::Run;
+      s.speed_scale = m.speed_scale();
+      s.separation_m = m.separation_m();
+      s.person_id = m.person_id();
+      s.body_part = m.body_part().to_string();
+      s.reason = m.reason().to_string();
+      scene_.add_safety(s, log_ns);
+      ++r_.safety;
     }
   } catch (const std::runtime_error&) {
     ++r_.undecodable;

@@ -15,7 +15,8 @@
 // "fused/fusion/1", "truth/sim/2"): joints as spheres (tracked opaque,
 // inferred translucent, lost left out), bones as a line list, a colour per
 // stream; a frustum per sensor; a pointing event's ray and target; the
-// robot's capsules. Each has a lifetime, so a person who left disappears.
+// robot's capsules, coloured by the separation monitor's verdict, and that
+// verdict as a label. Each has a lifetime, so a person who left disappears.
 #include <cstdint>
 #include <map>
 #include <set>
@@ -55,6 +56,17 @@ struct Pointing {  // a pointing event (skelgraph/gesture/event), world frame
   double confidence = 0;
 };
 
+enum class SafetyState { Run, Reduced, ProtectiveStop };
+
+struct Safety {  // speed-and-separation monitoring's verdict (skelgraph/safety)
+  std::string robot_id;
+  SafetyState state = SafetyState::Run;
+  double speed_scale = 1.0;
+  double separation_m = -1.0;  // -1: nobody
+  std::uint32_t person_id = 0;
+  std::string body_part, reason;
+};
+
 struct Capsule {  // world frame
   Eigen::Vector3d a = Eigen::Vector3d::Zero(), b = Eigen::Vector3d::Zero();
   double radius = 0.05;
@@ -76,6 +88,9 @@ class SceneBuilder {
   void add_pose(const skeleton::SensorPose& pose, std::int64_t log_ns);
   void add_pointing(const Pointing& p, std::int64_t log_ns);
   void add_robot(const std::string& robot_id, const std::vector<Capsule>& capsules, bool stopped, std::int64_t log_ns);
+  // The robot's colour follows it (green run, amber reduced, red stop) and a
+  // label above its base says why ("safety/<robot>").
+  void add_safety(const Safety& s, std::int64_t log_ns);
   // Everything decided before log_ns (ticks that ended); then finish() for the rest.
   std::vector<Output> take(std::int64_t log_ns);
   std::vector<Output> finish();
@@ -96,6 +111,8 @@ class SceneBuilder {
   std::map<std::string, Entity> pending_;      // by id: the latest of each in the open tick
   std::map<std::string, skeleton::SensorPose> poses_;
   std::set<std::string> unplaced_;
+  std::map<std::string, SafetyState> safety_;         // by robot: the latest verdict
+  std::map<std::string, Eigen::Vector3d> robot_base_;  // by robot: where its first capsule starts
   std::map<std::string, int> sensor_index_;    // colours in order of appearance
   std::int64_t transforms_at_ = -1;            // when the poses were last given out
   std::vector<Output> out_;

@@ -23,7 +23,7 @@ inline constexpr const char* kTransformTopic = "skelgraph/scene/transforms";
 
 struct ExportReport {
   std::uint64_t copied = 0;       // input messages written again
-  std::uint64_t skeletons = 0, poses = 0, pointing = 0, robot_states = 0;  // what went into the scene
+  std::uint64_t skeletons = 0, poses = 0, pointing = 0, robot_states = 0, safety = 0;  // what went into the scene
   std::uint64_t updates = 0, entities = 0, transforms = 0;                // what came out
   std::uint64_t undecodable = 0;  // messages on a known topic that did not decode (left out of the scene)
   std::vector<std::string> unplaced;  // frames without a pose, drawn at the world's origin
