@@ -521,3 +521,59 @@ TEST(SharedData, Msrc12FilesReadWithDocumentedFramesAndTags) {
     EXPECT_NE(std::string(e.what()).find("P1_1_12A_p19.csv:1029: no skeleton frames"), std::string::npos) << e.what();
   }
 }
+
+// Annotations for any recording: a CSV beside it (seconds or frames), per-frame
+// labels as ranges; the CSV beside a file wins over the format's own.
+TEST(Readers, AnnotationCsvAndFrameLabels) {
+  std::ostringstream os;
+  for (int t = 0; t < 4; ++t) {
+    os << t * 33000;
+    for (int j = 0; j < 20; ++j) os << " " << 0.1 * j << " 1 2.5 1";
+    os << "\r\n";
+  }
+  const auto path = write_file("P1_1_8_p07.csv", os.str());
+  write_file("P1_1_8_p07.tagstream", "XQPCTick;Tag\r\n4987500;G8\r\n");
+  auto rec = read_recording(Format::Msrc12, path);
+  ASSERT_EQ(annotations_of(rec).size(), 1u);  // the tagstream
+  const auto seconds = write_file("s.csv", "label,start_s,end_s\nwave,0.05,0.066\npoint,0,0\n");
+  const auto a = read_annotation_csv(seconds, rec);
+  ASSERT_EQ(a.size(), 2u);
+  EXPECT_EQ(a[0].label, "point");  // in time order
+  EXPECT_EQ(a[1].start_ns, 50'000'000);
+  EXPECT_EQ(a[1].end_ns, 66'000'000);
+  const auto frames = write_file("f.csv", "label,start_frame,end_frame\nwave,1,3\n");
+  const auto b = read_annotation_csv(frames, rec);
+  ASSERT_EQ(b.size(), 1u);
+  EXPECT_EQ(b[0].start_ns, 33'000'000);
+  EXPECT_EQ(b[0].end_ns, 99'000'000);
+  const auto error = [&](const std::string& text) {
+    try {
+      read_annotation_csv(write_file("bad.csv", text), rec);
+    } catch (const DataError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(error("label,start_frame,end_frame\nwave,1,4\n").find("bad.csv:2: end_frame 4 is outside the recording's 4 frames"),
+            std::string::npos);
+  EXPECT_NE(error("label,start_s,end_s\nwave,0.5,0.1\n").find("bad.csv:2: the annotation ends before it starts"), std::string::npos);
+  EXPECT_NE(error("name,from,to\n").find("bad.csv:1: expected a header"), std::string::npos);
+  // Beside the file, it wins over the tagstream.
+  write_file("P1_1_8_p07.annotations.csv", "label,start_frame,end_frame\nwave,1,3\nwave,3,3\n");
+  EXPECT_EQ(annotations_of(rec).size(), 2u);
+  // Per-frame labels: runs, rest left out.
+  Recording phases;
+  phases.source = ::testing::TempDir() + "/phases.csv";
+  for (int t = 0; t < 6; ++t) {
+    skelgraph::skeleton::Skeleton s;
+    s.stamp_ns = t * 10;
+    phases.frames.push_back(s);
+  }
+  phases.frame_labels = {"Rest", "Stroke", "Stroke", "Hold", "Rest", "Stroke"};
+  const auto runs = annotations_from_frame_labels(phases);
+  ASSERT_EQ(runs.size(), 3u);
+  EXPECT_EQ(runs[0].label, "Stroke");
+  EXPECT_EQ(runs[0].start_ns, 10);
+  EXPECT_EQ(runs[0].end_ns, 20);
+  EXPECT_EQ(runs[2].start_ns, 50);
+}

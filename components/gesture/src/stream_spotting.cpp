@@ -39,15 +39,18 @@ nlohmann::json StreamSpotOptions::to_json() const {
 }
 
 AnnotatedStream annotated_stream(const playback::Recording& rec, const FeatureOptions& features) {
-  if (rec.annotations.empty())
-    throw ModelError(rec.source + ": no annotations (MSRC-12: a .tagstream file beside it)");
+  auto annotations = playback::annotations_of(rec);
+  if (annotations.empty())
+    throw ModelError(rec.source + ": no annotations (a " +
+                     std::filesystem::path(rec.source).stem().string() +
+                     ".annotations.csv beside it, MSRC-12's .tagstream, or per-frame labels)");
   AnnotatedStream s;
   s.source = rec.source;
   const auto it = rec.metadata.find("subject");
   s.subject = it != rec.metadata.end() ? it->second : std::filesystem::path(rec.source).stem().string();
   for (const auto& f : rec.frames) s.stamps.push_back(f.stamp_ns);
   s.x = recording_features(rec, features).x;
-  s.annotations = rec.annotations;
+  s.annotations = std::move(annotations);
   return s;
 }
 
@@ -80,11 +83,11 @@ std::vector<Clip> stream_windows(const AnnotatedStream& s, const ClassMap& map, 
     c.x = window_at(s, end, o.window_s);
     if (c.x.rows() >= 3) clips.push_back(std::move(c));
   };
-  for (const auto& a : s.annotations)
-    for (double d : o.positive_offsets_s) add(a.start_ns + ns(d), a.label);
+  for (const auto& a : s.annotations)  // an action point, or a range's end: the gesture is complete there
+    for (double d : o.positive_offsets_s) add(a.end_ns + ns(d), a.label);
   for (auto t = s.stamps.front() + ns(o.window_s); t <= s.stamps.back(); t += ns(o.negative_step_s)) {
     bool near = false;
-    for (const auto& a : s.annotations) near = near || std::llabs(t - a.start_ns) < ns(o.negative_gap_s);
+    for (const auto& a : s.annotations) near = near || (t > a.start_ns - ns(o.negative_gap_s) && t < a.end_ns + ns(o.negative_gap_s));
     if (!near) add(t, map.garbage);
   }
   return clips;

@@ -1,5 +1,6 @@
 #include "skelgraph/playback/readers.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <filesystem>
@@ -514,6 +515,62 @@ std::vector<Annotation> read_tagstream(const std::string& path) {
     out.push_back({f[1], us * 1000, us * 1000});
   }
   return out;
+}
+
+std::vector<Annotation> read_annotation_csv(const std::string& path, const Recording& rec) {
+  CsvReader csv(path);
+  std::vector<std::string> f;
+  if (!csv.next(f)) csv.fail("empty file; expected a header 'label,start_s,end_s' or 'label,start_frame,end_frame'");
+  const bool seconds = f == std::vector<std::string>{"label", "start_s", "end_s"};
+  const bool frames = f == std::vector<std::string>{"label", "start_frame", "end_frame"};
+  if (!seconds && !frames) csv.fail("expected a header 'label,start_s,end_s' or 'label,start_frame,end_frame'");
+  if (rec.frames.empty()) csv.fail("the recording it annotates has no frames");
+  const auto t0 = rec.frames.front().stamp_ns;
+  std::vector<Annotation> out;
+  while (csv.next(f)) {
+    expect_fields(csv, f, 3, seconds ? "label, start_s, end_s" : "label, start_frame, end_frame");
+    if (f[0].empty()) csv.fail("an empty label");
+    Annotation a;
+    a.label = f[0];
+    if (seconds) {
+      a.start_ns = t0 + static_cast<std::int64_t>(std::llround(csv.number(f, 1, "start_s") * 1e9));
+      a.end_ns = t0 + static_cast<std::int64_t>(std::llround(csv.number(f, 2, "end_s") * 1e9));
+    } else {
+      const auto frame = [&](std::size_t i, const char* column) {
+        const auto k = csv.integer(f, i, column);
+        if (k < 0 || static_cast<std::size_t>(k) >= rec.frames.size())
+          csv.fail(std::string(column) + " " + std::to_string(k) + " is outside the recording's " +
+                   std::to_string(rec.frames.size()) + " frames");
+        return rec.frames[static_cast<std::size_t>(k)].stamp_ns;
+      };
+      a.start_ns = frame(1, "start_frame");
+      a.end_ns = frame(2, "end_frame");
+    }
+    if (a.end_ns < a.start_ns) csv.fail("the annotation ends before it starts");
+    out.push_back(std::move(a));
+  }
+  std::stable_sort(out.begin(), out.end(), [](const Annotation& a, const Annotation& b) { return a.start_ns < b.start_ns; });
+  return out;
+}
+
+std::vector<Annotation> annotations_from_frame_labels(const Recording& rec, const std::vector<std::string>& rest) {
+  std::vector<Annotation> out;
+  const auto n = std::min(rec.frame_labels.size(), rec.frames.size());
+  for (std::size_t i = 0; i < n;) {
+    std::size_t j = i;
+    while (j + 1 < n && rec.frame_labels[j + 1] == rec.frame_labels[i]) ++j;
+    if (std::find(rest.begin(), rest.end(), rec.frame_labels[i]) == rest.end())
+      out.push_back({rec.frame_labels[i], rec.frames[i].stamp_ns, rec.frames[j].stamp_ns});
+    i = j + 1;
+  }
+  return out;
+}
+
+std::vector<Annotation> annotations_of(const Recording& rec) {
+  const auto beside = fs::path(rec.source).replace_extension(".annotations.csv");
+  if (fs::exists(beside)) return read_annotation_csv(beside.string(), rec);
+  if (!rec.annotations.empty()) return rec.annotations;
+  return annotations_from_frame_labels(rec);
 }
 
 std::string skipped_summary(const Recording& rec) {

@@ -28,9 +28,11 @@ struct AnnotatedStream {
   std::vector<playback::Annotation> annotations;
 };
 
-// A recording with annotations (e.g. MSRC-12 with its .tagstream) as a stream
-// of features; a ModelError when the recording has no annotations or the
-// feature set needs wrists it lacks. Subject: the recording's "subject"
+// A recording with annotations (playback::annotations_of: an
+// .annotations.csv beside it, MSRC-12's .tagstream, per-frame labels) as a
+// stream of features; a ModelError when it has none or the feature set needs
+// wrists it lacks. Ranges are trained on and scored at their end (the gesture
+// is complete there); action points are ranges of no length. Subject: the recording's "subject"
 // metadata, else the file name.
 AnnotatedStream annotated_stream(const playback::Recording& recording, const FeatureOptions& features);
 

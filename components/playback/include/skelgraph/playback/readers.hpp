@@ -75,6 +75,24 @@ Recording read_recording(Format format, const std::string& path, const ReadOptio
 // / 49875). Throws DataError naming file:line.
 std::vector<Annotation> read_tagstream(const std::string& path);
 
+// An annotation file for any recording, CSV with a header: `label,start_s,end_s`
+// (seconds from the recording's first frame) or `label,start_frame,end_frame`
+// (frame indices, 0-based, inclusive); an action point has start == end.
+// `recording` gives the clock. Throws DataError naming file:line (a start
+// after its end, a frame outside the recording, an unknown header).
+std::vector<Annotation> read_annotation_csv(const std::string& path, const Recording& recording);
+
+// Per-frame labels (gesture-phase) as ranges: each run of one label becomes
+// an annotation from its first to its last frame; labels in `rest` are none.
+std::vector<Annotation> annotations_from_frame_labels(const Recording& recording,
+                                                      const std::vector<std::string>& rest = {"Rest", "rest", "none", ""});
+
+// The annotations of a recording file, in this order: FILE's stem +
+// ".annotations.csv" beside it (read_annotation_csv), else the format's own
+// (MSRC-12's .tagstream, already in recording.annotations; gesture-phase's
+// per-frame labels). Empty when there are none.
+std::vector<Annotation> annotations_of(const Recording& recording);
+
 // "FILE: N bad lines skipped (first: ...)" when lines were skipped, else "".
 std::string skipped_summary(const Recording& recording);
 
