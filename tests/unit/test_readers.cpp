@@ -80,8 +80,10 @@ TEST(Readers, KinderGatorMapsJointsAndKeepsLabels) {
   const std::int64_t day_ns = 1469145600000LL * 1000000LL;
   EXPECT_EQ(rec.frames[0].stamp_ns, day_ns + 48000000500000LL);
   EXPECT_EQ(rec.frames[1].stamp_ns - rec.frames[0].stamp_ns, 32750000);
-  // The wrists (joints 6 and 10) are not canonical joints: one per frame in extra_joints.
-  ASSERT_EQ(rec.extra_joints.size(), 2u);
+  // The wrists (joints 6 and 10), the hip centre and the ankles are not
+  // canonical joints: one per frame in extra_joints.
+  ASSERT_EQ(rec.extra_joints.size(), 5u);
+  EXPECT_TRUE(rec.extra_joints.at("left_ankle")[0].isApprox(Eigen::Vector3d(0.14, 0.24, 0.34)));
   ASSERT_EQ(rec.extra_joints.at("left_wrist").size(), 2u);
   ASSERT_EQ(rec.extra_joints.at("right_wrist").size(), 2u);
   EXPECT_TRUE(rec.extra_joints.at("left_wrist")[1].isApprox(Eigen::Vector3d(0.06, 0.16, 0.26)));
@@ -532,6 +534,7 @@ TEST(Readers, AnnotationCsvAndFrameLabels) {
     os << "\r\n";
   }
   const auto path = write_file("P1_1_8_p07.csv", os.str());
+  fs::remove(::testing::TempDir() + "/P1_1_8_p07.annotations.csv");  // left by an earlier run
   write_file("P1_1_8_p07.tagstream", "XQPCTick;Tag\r\n4987500;G8\r\n");
   auto rec = read_recording(Format::Msrc12, path);
   ASSERT_EQ(annotations_of(rec).size(), 1u);  // the tagstream
@@ -576,4 +579,42 @@ TEST(Readers, AnnotationCsvAndFrameLabels) {
   EXPECT_EQ(runs[0].start_ns, 10);
   EXPECT_EQ(runs[0].end_ns, 20);
   EXPECT_EQ(runs[2].start_ns, 50);
+}
+
+// The generic CSV keeps every joint a sensor gives: real Kinect v2 and
+// KinectMultiTrack files through it and back, untracked joints (NaN) included.
+TEST(SharedData, GenericCsvKeepsEveryJointOfRealFiles) {
+  const auto data = fs::path(data_dir());
+  const std::vector<std::pair<Format, fs::path>> files = {
+      {Format::KinectV2, data / "laban" / "Ges05_demopoint.csv"},
+      {Format::MultiTrack, data / "kinect-multitrack" / "Experiments_1_2_3_6" / "Study_12_Kinect_2_Time_5_01_13_PM.csv"},
+      {Format::Msrc12, data / "msrc12" / "P1_1_10_p19.csv"}};
+  for (const auto& [format, path] : files) {
+    ASSERT_TRUE(fs::exists(path)) << path << " is missing: tests read ../shared/data (or SKELGRAPH_DATA_DIR)";
+    const auto rec = read_recording(format, path.string());
+    EXPECT_GE(rec.extra_joints.size(), format == Format::Msrc12 ? 5u : 10u) << path;
+    std::ostringstream os;
+    write_generic_csv(rec, os);
+    const auto back = read_recording(Format::Generic, write_file("extras.csv", os.str()));
+    ASSERT_EQ(back.frames.size(), rec.frames.size()) << path;
+    ASSERT_EQ(back.extra_joints.size(), rec.extra_joints.size()) << path;
+    std::size_t missing = 0;
+    for (const auto& [name, points] : rec.extra_joints) {
+      const auto& got = back.extra_joints.at(name);
+      ASSERT_EQ(got.size(), points.size()) << name;
+      for (std::size_t t = 0; t < points.size(); ++t) {
+        for (Eigen::Index k = 0; k < 3; ++k) {
+          if (std::isnan(points[t][k])) {
+            EXPECT_TRUE(std::isnan(got[t][k])) << name << " frame " << t;
+            ++missing;
+          } else {
+            EXPECT_DOUBLE_EQ(got[t][k], points[t][k]) << name << " frame " << t;
+          }
+        }
+      }
+    }
+    if (format == Format::Msrc12) {
+      EXPECT_EQ(missing, 0u);
+    }
+  }
 }

@@ -90,6 +90,15 @@ void add_wrists(Recording& rec, const Eigen::Vector3d& left, const Eigen::Vector
   rec.extra_joints["right_wrist"].push_back(right);
 }
 
+// Every other joint the sensor gives beyond the canonical 15 and the wrists
+// (extra joint name, source index), for the frame about to be appended.
+template <class Position>
+void add_extras(Recording& rec, const std::vector<std::pair<const char*, std::size_t>>& extras, Position position) {
+  for (const auto& [name, src] : extras) rec.extra_joints[name].push_back(position(src));
+}
+// Kinect v1 (NUI order): the hip centre and the ankles.
+const std::vector<std::pair<const char*, std::size_t>> kV1Extras = {{"pelvis", 0}, {"left_ankle", 14}, {"right_ankle", 18}};
+
 void expect_fields(const CsvReader& csv, const std::vector<std::string>& f, std::size_t n, const char* what) {
   if (f.size() != n) {
     csv.fail("expected " + std::to_string(n) + " fields (" + what + "), got " + std::to_string(f.size()));
@@ -148,6 +157,7 @@ Recording read_kinder_gator(const std::string& path, const ReadOptions& opt) {
       rec.metadata["action"] = f[62];
     }
     add_wrists(rec, xyz(csv, f, 1 + 3 * 6, kV1Joints[6]), xyz(csv, f, 1 + 3 * 10, kV1Joints[10]));
+    add_extras(rec, kV1Extras, [&](std::size_t j) { return xyz(csv, f, 1 + 3 * j, kV1Joints[j]); });
     rec.frames.push_back(std::move(s));
   });
   return rec;
@@ -191,6 +201,7 @@ Recording read_msrc12(const std::string& path, const ReadOptions& opt) {
       s.joints[i].confidence = skeleton::kTracked;  // the format has no tracking state
     }
     add_wrists(rec, joint(6), joint(10));
+    add_extras(rec, kV1Extras, joint);
     rec.frames.push_back(std::move(s));
   });
   return rec;
@@ -206,6 +217,11 @@ const std::array<const char*, 25> kV2Joints = {
 // Neck is SpineShoulder (between the shoulders, where NITE and Kinect v1 put it),
 // torso is SpineMid.
 const std::array<std::size_t, kJointCount> kV2Map = {3, 20, 1, 4, 5, 7, 8, 9, 11, 12, 13, 15, 16, 17, 19};
+
+// Kinect v2 (JointType order): spine base, the upper neck, ankles, hand tips and thumbs.
+const std::vector<std::pair<const char*, std::size_t>> kV2Extras = {
+    {"pelvis", 0},          {"upper_neck", 2},  {"left_ankle", 14},     {"right_ankle", 18},
+    {"left_hand_tip", 21},  {"left_thumb", 22}, {"right_hand_tip", 23}, {"right_thumb", 24}};
 
 Recording read_kinect_v2(const std::string& path, const ReadOptions& opt) {
   auto rec = empty_recording(Format::KinectV2, path);
@@ -238,6 +254,7 @@ Recording read_kinect_v2(const std::string& path, const ReadOptions& opt) {
       return tracked ? xyz(csv, f, col, kV2Joints[src]) : Eigen::Vector3d::Constant(std::nan(""));
     };
     add_wrists(rec, wrist(6), wrist(10));
+    add_extras(rec, kV2Extras, wrist);
     rec.frames.push_back(std::move(s));
   });
   return rec;
@@ -254,6 +271,11 @@ const std::array<const char*, 25> kMtJoints = {
 const std::array<std::size_t, kJointCount> kMtMap = {10, 20, 19, 16, 2, 6, 17, 3, 7, 11, 13, 4, 12, 14, 5};
 constexpr std::size_t kMtFields = 12 + 3 * 25;
 constexpr std::int64_t kDotNetEpochToUnixMs = 62'135'596'800'000LL;  // ms from 0001-01-01 to 1970-01-01
+
+// The same extra joints as Kinect v2, in the data set's alphabetical order.
+const std::vector<std::pair<const char*, std::size_t>> kMtExtras = {
+    {"pelvis", 18},         {"upper_neck", 15}, {"left_ankle", 0},      {"right_ankle", 1},
+    {"left_hand_tip", 8},   {"left_thumb", 21}, {"right_hand_tip", 9},  {"right_thumb", 22}};
 
 Recording read_multitrack(const std::string& path, const ReadOptions& opt) {
   auto rec = empty_recording(Format::MultiTrack, path);
@@ -315,6 +337,7 @@ Recording read_multitrack(const std::string& path, const ReadOptions& opt) {
       return missing ? Eigen::Vector3d::Constant(std::nan("")) : p;
     };
     add_wrists(rec, wrist(23), wrist(24));
+    add_extras(rec, kMtExtras, wrist);
     if (rec.metadata.empty()) {
       rec.metadata["study"] = f[0];
       rec.metadata["kinect_config"] = f[1];
@@ -426,8 +449,19 @@ Recording read_generic(const std::string& path, const ReadOptions& opt) {
   for (std::size_t j = 0; j < kJointCount; ++j) {
     for (const auto* suffix : kJointFields) known.push_back(std::string(skeleton::joint_name(skeleton::joint_at(j))) + "_" + suffix);
   }
+  // Joints beyond the canonical 15: extra_<name>_x/_y/_z (empty: not reported).
+  std::map<std::string, std::array<std::size_t, 3>> extra_cols;
   for (const auto& h : header) {
-    if (std::find(known.begin(), known.end(), h) == known.end()) csv.fail("unknown column '" + h + "'");
+    if (std::find(known.begin(), known.end(), h) != known.end()) continue;
+    static const std::regex extra("extra_([a-z0-9_]+)_([xyz])");
+    std::smatch m;
+    if (!std::regex_match(h, m, extra)) csv.fail("unknown column '" + h + "'");
+    auto [it, fresh] = extra_cols.try_emplace(m[1].str(), std::array<std::size_t, 3>{SIZE_MAX, SIZE_MAX, SIZE_MAX});
+    it->second[static_cast<std::size_t>(m[2].str()[0] - 'x')] = col[h];
+  }
+  for (const auto& [name, c] : extra_cols) {
+    for (std::size_t k = 0; k < 3; ++k)
+      if (c[k] == SIZE_MAX) csv.fail("missing column 'extra_" + name + "_" + std::string(1, static_cast<char>('x' + k)) + "'");
   }
   for (const auto& r : required_base) {
     if (!col.count(r)) csv.fail("missing column '" + r + "'");
@@ -464,6 +498,14 @@ Recording read_generic(const std::string& path, const ReadOptions& opt) {
       const double conf = csv.number(row, col[n + "_conf"], n + "_conf");
       if (conf < 0.0 || conf > 1.0) csv.fail(n + "_conf expects a confidence in [0, 1], got " + row[col[n + "_conf"]]);
       joint.confidence = static_cast<float>(conf);
+    }
+    for (const auto& [name, c] : extra_cols) {
+      Eigen::Vector3d p;
+      for (std::size_t k = 0; k < 3; ++k) {
+        const std::string column = "extra_" + name + "_" + std::string(1, static_cast<char>('x' + k));
+        p[static_cast<Eigen::Index>(k)] = row[c[k]].empty() ? std::nan("") : csv.number(row, c[k], column);
+      }
+      rec.extra_joints[name].push_back(p);
     }
     rec.frames.push_back(std::move(s));
   });
@@ -593,6 +635,13 @@ void write_generic_csv(const Recording& rec, std::ostream& out) {
   for (std::size_t j = 0; j < kJointCount; ++j) {
     for (const auto* suffix : kJointFields) out << "," << skeleton::joint_name(skeleton::joint_at(j)) << "_" << suffix;
   }
+  for (const auto& [name, points] : rec.extra_joints) {
+    if (points.size() != rec.frames.size())
+      throw std::invalid_argument("generic CSV: extra joint '" + name + "' has " + std::to_string(points.size()) + " positions for " +
+                                  std::to_string(rec.frames.size()) + " frames");
+    if (!std::regex_match(name, std::regex("[a-z0-9_]+"))) throw std::invalid_argument("generic CSV: extra joint name '" + name + "'");
+    for (const char* axis : {"x", "y", "z"}) out << ",extra_" << name << "_" << axis;
+  }
   out << "\n" << std::setprecision(17);
   for (const auto& s : rec.frames) {
     for (const auto* id : {&s.sensor_id, &s.frame_id}) {
@@ -604,6 +653,13 @@ void write_generic_csv(const Recording& rec, std::ostream& out) {
     for (const auto& j : s.joints) {
       out << "," << j.position.x() << "," << j.position.y() << "," << j.position.z() << "," << j.orientation.w() << ","
           << j.orientation.x() << "," << j.orientation.y() << "," << j.orientation.z() << "," << j.confidence;
+    }
+    const auto frame = static_cast<std::size_t>(&s - rec.frames.data());
+    for (const auto& [name, points] : rec.extra_joints) {
+      for (Eigen::Index k = 0; k < 3; ++k) {
+        out << ",";
+        if (std::isfinite(points[frame][k])) out << points[frame][k];  // empty: not reported
+      }
     }
     out << "\n";
   }

@@ -56,8 +56,11 @@ struct Recording {
   std::map<std::string, std::string> metadata;  // e.g. action, subject, gesture
   std::vector<skeleton::Skeleton> frames;       // in time order
   std::vector<std::string> frame_labels;        // per frame when the format has them (gesture-phase), else empty
-  // Joints the canonical 15 leave out, one position per frame, when the format
-  // has them: "left_wrist", "right_wrist" (Kinect v1 and v2, gesture-phase).
+  // Joints the canonical 15 leave out, one position per frame (NaN: not
+  // reported), when the format has them: "left_wrist", "right_wrist" (Kinect
+  // v1 and v2, gesture-phase); "pelvis", "left_ankle", "right_ankle" (v1, v2);
+  // "upper_neck", "left_hand_tip", "right_hand_tip", "left_thumb",
+  // "right_thumb" (v2, multitrack). The generic CSV keeps them all.
   // Gesture features can use them offline; the skeleton topics do not carry them.
   std::map<std::string, std::vector<Eigen::Vector3d>> extra_joints;
   std::vector<Annotation> annotations;          // in time order, when the format has them
@@ -98,7 +101,9 @@ std::string skipped_summary(const Recording& recording);
 
 // skelgraph's own CSV: "# skelgraph skeleton csv v1", "# key: value" metadata
 // lines, a header, then one row per skeleton with every joint's position,
-// orientation and confidence. Reading it back gives the same recording.
+// orientation and confidence, and every extra joint's position
+// (extra_<name>_x/_y/_z, empty where it was not reported). Reading it back
+// gives the same recording.
 void write_generic_csv(const Recording& recording, std::ostream& out);
 
 }  // namespace skelgraph::playback
