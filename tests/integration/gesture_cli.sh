@@ -158,3 +158,18 @@ rc=0
 grep -q "P1_1_12A_p19.csv:1029: no skeleton frames" "$WORK/msrc2.err" || fail "the empty stream: $(cat "$WORK/msrc2.err")"
 json_check "$WORK/msrc2.json" 'd["streams"] == 6'
 ok "annotated streams (MSRC-12 G1, G12): leave-subject-out spotting, macro F1 $(json_get "$WORK/msrc.json" 'round(d["macro_f1"], 3)')"
+
+# A stream spotter trained on two people's annotated streams, saved, then used
+# on the third person's (gesture spot --model): events per file, scored.
+mkdir -p "$WORK/msrc_train"
+for f in "$MS"/P1_1_1_p06.* "$MS"/P1_1_1_p19.* "$MS"/P1_1_12_p06.* "$MS"/P1_1_12_p19.*; do ln -s "$f" "$WORK/msrc_train/"; done
+"$S" gesture train --spot --format msrc12 "$WORK/msrc_train" --out "$WORK/stream_model.json" --json >"$WORK/stream_train.json" \
+  2>"$WORK/stream_train.err" || fail "train --spot: $(cat "$WORK/stream_train.err")"
+json_check "$WORK/stream_train.json" 'd["streams"] == 4 and len(d["classes"]) == 2 and d["training_windows"] > 300'
+"$S" gesture spot --model "$WORK/stream_model.json" --format msrc12 "$MS"/P1_1_1_p21.csv "$MS"/P1_1_12_p21.csv --json \
+  >"$WORK/stream_spot.json" 2>"$WORK/stream_spot.err" || fail "spot --model: $(cat "$WORK/stream_spot.err")"
+json_check "$WORK/stream_spot.json" 'len(d["files"]) == 2 and all(len(f["events"]) > 3 for f in d["files"]) and [c["truth"] for c in d["per_class"]] == [11, 11] and d["macro_f1"] > 0.7'
+rc=0
+"$S" gesture spot --model "$WORK/model.json" --format msrc12 "$MS"/P1_1_1_p21.csv >/dev/null 2>"$WORK/not_stream.err" || rc=$?
+[ "$rc" -eq 2 ] && grep -q "not a stream spotter" "$WORK/not_stream.err" || fail "a clip classifier given to spot --model: rc $rc, $(cat "$WORK/not_stream.err")"
+ok "stream spotter trained on two people, spotting the third's streams: macro F1 $(json_get "$WORK/stream_spot.json" 'round(d["macro_f1"], 3)')"

@@ -497,6 +497,25 @@ TEST(StreamSpotting, FindsEachGestureNearItsActionPoint) {
   }
   EXPECT_GE(r.macro_f1, 0.9);
   EXPECT_LT(std::abs(r.median_latency_s), o.slack_s);
+  // Trained on all, saved and loaded: the same events.
+  ClassifierOptions knn_options;
+  knn_options.features.set = FeatureSet::Body;
+  const auto spotter = StreamSpotter::train(streams, knn_options, o);
+  const auto path = ::testing::TempDir() + "/stream_spotter.json";
+  spotter.save(path);
+  ASSERT_TRUE(StreamSpotter::is_stream_spotter(path));
+  const auto loaded = StreamSpotter::load(path);
+  EXPECT_EQ(loaded.classes(), (std::vector<std::string>{"A", "B"}));
+  EXPECT_EQ(loaded.feature_set(), FeatureSet::Body);
+  const auto before = spotter.spot(streams[1]), after = loaded.spot(streams[1]);
+  ASSERT_EQ(before.size(), after.size());
+  ASSERT_GE(before.size(), 10u);
+  for (std::size_t i = 0; i < before.size(); ++i) {
+    EXPECT_EQ(before[i].label, after[i].label);
+    EXPECT_EQ(before[i].end_ns, after[i].end_ns);
+  }
+  std::ofstream(::testing::TempDir() + "/not_spotter.json") << R"({"format": "skelgraph-stream-spotter", "version": 1})";
+  EXPECT_THROW(StreamSpotter::load(::testing::TempDir() + "/not_spotter.json"), ModelError);
   // The same windows through the HMM classifier run end to end too.
   o.model = "hmm";
   ClassifierOptions c;

@@ -149,7 +149,11 @@ nlohmann::json config_json(const ClassifierOptions& c) {
           {"trimmed", c.trimmed}};
 }
 
+int gesture_train_streams(const GestureOptions& o);
+int gesture_spot_model(const GestureOptions& o);
+
 int gesture_train(const GestureOptions& o) {
+  if (o.spot_streams) return gesture_train_streams(o);
   const auto map = class_map(o.classes);
   const auto c = classifier_options(o);
   BadInputs bad;
@@ -191,20 +195,17 @@ CvRun run_cv(const GestureOptions& o, const ClassMap& map, const std::vector<Cli
   return {c, evaluate(results, map.classes), results};
 }
 
-// cv --spot: annotated streams, leave-subject-out, a sliding-window spotter (stream_spotting.hpp).
-int gesture_cv_streams(const GestureOptions& o) {
-  auto c = classifier_options(o);
-  c.trimmed = false;  // windows are classified whole
+// The inputs as annotated streams (annotations required unless `require` is
+// false); a bad file is reported in `bad` and left out.
+std::vector<AnnotatedStream> load_streams(const GestureOptions& o, const FeatureOptions& features, bool require, BadInputs& bad) {
   const auto format = *playback::format_from_name(o.format);
-  BadInputs bad;
   std::vector<AnnotatedStream> streams;
-  const auto files = expand_paths(o.inputs);
-  for (const auto& file : files) {
+  for (const auto& file : expand_paths(o.inputs)) {
     bad.guard([&] {
       const auto rec = playback::read_recording(format, file, read_options(o));
       note_skipped(rec);
       try {
-        streams.push_back(annotated_stream(rec, c.features));
+        streams.push_back(annotated_stream(rec, features, require));
       } catch (const ModelError& e) {
         throw UsageError(e.what());
       }
@@ -212,8 +213,101 @@ int gesture_cv_streams(const GestureOptions& o) {
   }
   std::size_t tags = 0;
   for (const auto& s : streams) tags += s.annotations.size();
-  std::fprintf(stderr, "read %zu annotated streams (%zu action points)\n", streams.size(), tags);
-  if (streams.empty()) throw UsageError("no annotated stream among the inputs");
+  std::fprintf(stderr, "read %zu streams (%zu annotations)\n", streams.size(), tags);
+  if (streams.empty()) throw UsageError(require ? "no annotated stream among the inputs" : "no stream among the inputs");
+  return streams;
+}
+
+ClassifierOptions stream_classifier_options(const GestureOptions& o) {
+  auto c = classifier_options(o);
+  c.trimmed = false;  // windows are classified whole
+  return c;
+}
+
+// train --spot: a stream spotter from every annotated stream, saved for `gesture spot --model`.
+int gesture_train_streams(const GestureOptions& o) {
+  const auto c = stream_classifier_options(o);
+  BadInputs bad;
+  const auto streams = load_streams(o, c.features, true, bad);
+  const auto spotter = StreamSpotter::train(streams, c, o.stream);
+  if (!o.out.empty()) spotter.save(o.out);
+  if (o.json) {
+    std::printf("%s\n", nlohmann::json{{"streams", streams.size()},
+                                       {"classes", spotter.classes()},
+                                       {"training_windows", spotter.windows()},
+                                       {"config", config_json(c)},
+                                       {"spotting", o.stream.to_json()},
+                                       {"out", o.out}}
+                            .dump(2)
+                            .c_str());
+  } else {
+    std::printf("stream spotter (%s windows, %s features) trained on %zu windows of %zu streams, %zu classes%s\n",
+                o.stream.model.c_str(), feature_set_name(c.features.set), spotter.windows(), streams.size(),
+                spotter.classes().size(), o.out.empty() ? " (not saved: no --out)" : ("; saved to " + o.out).c_str());
+  }
+  return bad.exit_code(0, expand_paths(o.inputs).size());
+}
+
+// spot --model: a saved stream spotter over recordings; scored where they have annotations.
+int gesture_spot_model(const GestureOptions& o) {
+  if (!StreamSpotter::is_stream_spotter(o.model))
+    throw UsageError(o.model + ": not a stream spotter (make one with `gesture train --spot ... --out FILE`)");
+  const auto spotter = StreamSpotter::load(o.model);
+  FeatureOptions f;
+  f.set = spotter.feature_set();
+  BadInputs bad;
+  const auto streams = load_streams(o, f, false, bad);
+  std::map<std::string, std::vector<SpottingReport>> reports;
+  nlohmann::json files = nlohmann::json::array();
+  std::size_t annotated = 0;
+  for (const auto& s : streams) {
+    const auto events = spotter.spot(s);
+    nlohmann::json ev = nlohmann::json::array();
+    const auto t0 = s.stamps.empty() ? 0 : s.stamps.front();
+    for (const auto& e : events)
+      ev.push_back({{"label", e.label}, {"time_s", 1e-9 * static_cast<double>(e.end_ns - t0)}, {"confidence", e.confidence}});
+    files.push_back({{"file", s.source}, {"events", ev}, {"annotations", s.annotations.size()}});
+    if (!o.json) {
+      std::printf("%s: %zu events", s.source.c_str(), events.size());
+      for (const auto& e : events) std::printf("%s %s at %.2f s", &e == &events.front() ? ":" : ",", e.label.c_str(),
+                                               1e-9 * static_cast<double>(e.end_ns - t0));
+      std::printf("\n");
+    }
+    if (s.annotations.empty()) continue;
+    ++annotated;
+    const auto truth = stream_truth(s);
+    for (const auto& k : spotter.classes()) reports[k].push_back(score_spotting(events, truth, k, spotter.options().slack_s));
+  }
+  nlohmann::json out{{"model", o.model}, {"files", files}};
+  if (annotated > 0) {
+    nlohmann::json per = nlohmann::json::array();
+    double macro = 0;
+    std::vector<double> latencies;
+    for (const auto& k : spotter.classes()) {
+      const auto r = combine(reports[k]);
+      per.push_back(to_json(r));
+      macro += r.f1 / static_cast<double>(spotter.classes().size());
+      latencies.insert(latencies.end(), r.latency_s.begin(), r.latency_s.end());
+      if (!o.json)
+        std::printf("  %-28s %3d annotated, %3d events: precision %.3f recall %.3f F1 %.3f; latency median %+.0f ms\n",
+                    ("'" + k + "'").c_str(), r.truth, r.events, r.precision, r.recall, r.f1, 1e3 * r.median_latency_s);
+    }
+    out["per_class"] = per;
+    out["macro_f1"] = macro;
+    out["median_latency_s"] = median(latencies);
+    if (!o.json) std::printf("macro F1 %.3f over %zu annotated streams; events a median %+.0f ms after the annotation\n", macro,
+                             annotated, 1e3 * median(latencies));
+  }
+  if (o.json) std::printf("%s\n", out.dump(2).c_str());
+  return bad.exit_code(0, expand_paths(o.inputs).size());
+}
+
+// cv --spot: annotated streams, leave-subject-out, a sliding-window spotter (stream_spotting.hpp).
+int gesture_cv_streams(const GestureOptions& o) {
+  const auto c = stream_classifier_options(o);
+  BadInputs bad;
+  const auto streams = load_streams(o, c.features, true, bad);
+  const auto files = expand_paths(o.inputs);
   Progress progress;
   StreamSpotting r;
   try {
@@ -377,6 +471,7 @@ int gesture_cv(const GestureOptions& o) {
 
 // Leave-subject-out spotting in continuous streams of real clips (gesture/clip_spotting.hpp).
 int gesture_spot(const GestureOptions& o) {
+  if (!o.model.empty()) return gesture_spot_model(o);
   const auto map = class_map(o.classes);
   const auto c = classifier_options(o);
   BadInputs bad;
@@ -629,6 +724,19 @@ int gesture_sim(const GestureOptions& o) {
 
 void add_model_options(CLI::App* c, GestureOptions& o);
 
+// --spot and the stream spotter's options (cv, train).
+void add_stream_options(CLI::App* c, GestureOptions& o, const std::string& what) {
+  c->add_flag("--spot", o.spot_streams, what);
+  c->add_option("--window-model", o.stream.model, "--spot: the window classifier, knn (default) or hmm (the --states ... options)")
+      ->check(CLI::IsMember({"hmm", "knn"}));
+  c->add_option("--knn-k", o.stream.knn_k, "--spot --window-model knn: neighbours (default 5)")->check(CLI::Range(1, 100));
+  c->add_option("--window", o.stream.window_s, "--spot: s the classifier looks back (default 1.0)")->check(CLI::Range(0.2, 10.0));
+  c->add_option("--step", o.stream.step_s, "--spot: s between windows (default 0.1)")->check(CLI::Range(0.01, 2.0));
+  c->add_option("--confirm", o.stream.confirm, "--spot: windows in a row one gesture must win (default 2)")->check(CLI::Range(1, 50));
+  c->add_option("--refractory", o.stream.refractory_s, "--spot: s without another event of the same class (default 1.5)")
+      ->check(CLI::Range(0.0, 30.0));
+}
+
 void add_common(CLI::App* c, GestureOptions& o, bool model_options) {
   c->add_option("inputs", o.inputs, "recordings (files, or directories of .csv files)")->required()->check(CLI::ExistingPath);
   c->add_option("--format", o.format, "input format (default kinder-gator)")->check(CLI::IsMember(playback::format_names()));
@@ -708,25 +816,24 @@ void add_gesture_command(CLI::App& app, GlobalOptions&, Action& run) {
   g->require_subcommand(1);
   auto o = std::make_shared<GestureOptions>();
 
-  auto* t = g->add_subcommand("train", "Train one HMM per class (and the rejection threshold) on labelled clips");
+  auto* t = g->add_subcommand("train", "Train one HMM per class (and the rejection threshold) on labelled clips; with --spot a "
+                                       "stream spotter on annotated continuous streams");
   add_common(t, *o, true);
+  add_stream_options(t, *o,
+                     "the inputs are annotated continuous streams (see cv --spot): train a sliding-window stream spotter "
+                     "on all of them, for `gesture spot --model`; --features defaults to body here");
   t->add_option("--out", o->out, "write the classifier (JSON)");
-  t->callback([o, &run] { run = [o] { return gesture_train(*o); }; });
+  t->callback([o, t, &run] {
+    if (o->spot_streams && t->get_option("--features")->count() == 0) o->features = "body";
+    run = [o] { return gesture_train(*o); };
+  });
 
   auto* cv = g->add_subcommand("cv", "Cross-validate: confusion matrix, accuracy, per-class precision/recall/F1, ROC");
   add_common(cv, *o, true);
-  cv->add_flag("--spot", o->spot_streams,
-              "the inputs are annotated continuous streams (--format msrc12: a .tagstream beside each file): leave one "
-              "subject out, spot with a sliding window, score events against the action points (per class P/R/F1, "
-              "macro F1, latency); --features defaults to body here");
-  cv->add_option("--window-model", o->stream.model, "--spot: the window classifier, knn (default) or hmm (the --states ... options)")
-      ->check(CLI::IsMember({"hmm", "knn"}));
-  cv->add_option("--knn-k", o->stream.knn_k, "--spot --window-model knn: neighbours (default 5)")->check(CLI::Range(1, 100));
-  cv->add_option("--window", o->stream.window_s, "--spot: s the classifier looks back (default 1.0)")->check(CLI::Range(0.2, 10.0));
-  cv->add_option("--step", o->stream.step_s, "--spot: s between windows (default 0.1)")->check(CLI::Range(0.01, 2.0));
-  cv->add_option("--confirm", o->stream.confirm, "--spot: windows in a row one gesture must win (default 2)")->check(CLI::Range(1, 50));
-  cv->add_option("--refractory", o->stream.refractory_s, "--spot: s without another event of the same class (default 1.5)")
-      ->check(CLI::Range(0.0, 30.0));
+  add_stream_options(cv, *o,
+                     "the inputs are annotated continuous streams (an .annotations.csv beside each file, or --format msrc12's "
+                     ".tagstream): leave one subject out, spot with a sliding window, score events against the annotations "
+                     "(per class P/R/F1, macro F1, latency); --features defaults to body here");
   cv->add_option("--split", o->split, "lso: leave one subject out (default); kfold: stratified k-fold")
       ->check(CLI::IsMember({"lso", "kfold"}));
   cv->add_option("--folds", o->folds, "k for --split kfold (default 5)")->check(CLI::Range(2, 1000));
@@ -763,6 +870,10 @@ void add_gesture_command(CLI::App& app, GlobalOptions&, Action& run) {
       ->check(CLI::Range(0.0, 10.0));
   sp->add_option("--gap", o->gap, "s of the last frame held between clips (default 0: the clips' own idle starts and ends are the rest)")->check(CLI::Range(0.0, 10.0));
   add_spotter_options(sp, *o);
+  sp->add_option("--model", o->model,
+                 "a stream spotter from `gesture train --spot`: spot with it in the inputs (no training) and score where "
+                 "they have annotations")
+      ->check(CLI::ExistingFile);
   sp->callback([o, &run] { run = [o] { return gesture_spot(*o); }; });
 
   auto* sm = g->add_subcommand("sim", "Simulated pointing sessions (no outside data): train a classifier on some, spot "

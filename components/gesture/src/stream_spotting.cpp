@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <set>
 
@@ -38,9 +39,9 @@ nlohmann::json StreamSpotOptions::to_json() const {
           {"knn_samples", knn_samples}};
 }
 
-AnnotatedStream annotated_stream(const playback::Recording& rec, const FeatureOptions& features) {
+AnnotatedStream annotated_stream(const playback::Recording& rec, const FeatureOptions& features, bool require) {
   auto annotations = playback::annotations_of(rec);
-  if (annotations.empty())
+  if (annotations.empty() && require)
     throw ModelError(rec.source + ": no annotations (a " +
                      std::filesystem::path(rec.source).stem().string() +
                      ".annotations.csv beside it, MSRC-12's .tagstream, or per-frame labels)");
@@ -143,6 +144,52 @@ Decision WindowKnn::classify(const Sequence& x) const {
   return d;
 }
 
+nlohmann::json WindowKnn::to_json() const {
+  const auto matrix = [](const Eigen::MatrixXd& m) {
+    nlohmann::json rows = nlohmann::json::array();
+    for (Eigen::Index c = 0; c < m.cols(); ++c) rows.push_back(std::vector<double>(m.col(c).data(), m.col(c).data() + m.rows()));
+    return rows;
+  };
+  return {{"labels", labels_},
+          {"garbage", garbage_},
+          {"k", k_},
+          {"samples", samples_},
+          {"mean", std::vector<double>(mean_.data(), mean_.data() + mean_.size())},
+          {"scale", std::vector<double>(scale_.data(), scale_.data() + scale_.size())},
+          {"windows", matrix(train_)},
+          {"window_labels", label_}};
+}
+
+WindowKnn WindowKnn::from_json(const nlohmann::json& j) {
+  WindowKnn w;
+  try {
+    w.labels_ = j.at("labels").get<std::vector<std::string>>();
+    w.garbage_ = j.at("garbage").get<int>();
+    w.k_ = j.at("k").get<int>();
+    w.samples_ = j.at("samples").get<int>();
+    const auto mean = j.at("mean").get<std::vector<double>>();
+    const auto scale = j.at("scale").get<std::vector<double>>();
+    w.mean_ = Eigen::Map<const Eigen::VectorXd>(mean.data(), static_cast<Eigen::Index>(mean.size()));
+    w.scale_ = Eigen::Map<const Eigen::VectorXd>(scale.data(), static_cast<Eigen::Index>(scale.size()));
+    const auto& windows = j.at("windows");
+    w.label_ = j.at("window_labels").get<std::vector<int>>();
+    if (w.scale_.size() != w.mean_.size() || windows.size() != w.label_.size() || windows.empty() || w.k_ < 1 ||
+        w.samples_ < 1 || w.mean_.size() % w.samples_ != 0)
+      throw ModelError("knn: sizes do not agree");
+    w.train_.resize(w.mean_.size(), static_cast<Eigen::Index>(windows.size()));
+    for (std::size_t c = 0; c < windows.size(); ++c) {
+      const auto v = windows[c].get<std::vector<double>>();
+      if (static_cast<Eigen::Index>(v.size()) != w.mean_.size()) throw ModelError("knn: window " + std::to_string(c) + " has the wrong size");
+      w.train_.col(static_cast<Eigen::Index>(c)) = Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
+    }
+    for (int l : w.label_)
+      if (l < 0 || l >= static_cast<int>(w.labels_.size())) throw ModelError("knn: a window label out of range");
+  } catch (const nlohmann::json::exception& e) {
+    throw ModelError(std::string("knn: ") + e.what());
+  }
+  return w;
+}
+
 namespace {
 template <class Model>
 std::vector<SpottedEvent> spot_with(const Model& c, const AnnotatedStream& s, const StreamSpotOptions& o) {
@@ -194,6 +241,95 @@ nlohmann::json StreamSpotting::to_json() const {
   return {{"classes", classes},          {"per_class", per},  {"macro_f1", macro_f1},
           {"median_latency_s", median_latency_s}, {"streams", streams}, {"training_windows", windows},
           {"subjects", subjects}};
+}
+
+StreamSpotter StreamSpotter::train(const std::vector<AnnotatedStream>& streams, const ClassifierOptions& c,
+                                   const StreamSpotOptions& o) {
+  const auto map = stream_class_map(streams);
+  StreamSpotter s;
+  s.features_ = c.features.set;
+  s.options_ = o;
+  for (const auto& k : map.classes)
+    if (k != map.garbage) s.classes_.push_back(k);
+  std::vector<Clip> windows;
+  for (const auto& st : streams) {
+    auto w = stream_windows(st, map, o);
+    windows.insert(windows.end(), std::make_move_iterator(w.begin()), std::make_move_iterator(w.end()));
+  }
+  s.windows_ = windows.size();
+  if (o.model == "knn") s.knn_.emplace(windows, map, o.knn_k, o.knn_samples);
+  else s.hmm_ = Classifier::train(windows, map, c);
+  return s;
+}
+
+std::vector<SpottedEvent> StreamSpotter::spot(const AnnotatedStream& st) const {
+  return knn_ ? spot_stream(*knn_, st, options_) : spot_stream(*hmm_, st, options_);
+}
+
+const std::vector<std::string>& StreamSpotter::classes() const { return classes_; }
+
+void StreamSpotter::save(const std::string& path) const {
+  nlohmann::json j{{"format", "skelgraph-stream-spotter"},
+                   {"version", 1},
+                   {"features", feature_set_name(features_)},
+                   {"spotting", options_.to_json()},
+                   {"classes", classes_},
+                   {"training_windows", windows_}};
+  if (knn_) j["knn"] = knn_->to_json();
+  else j["hmm"] = hmm_->to_json();
+  std::ofstream f(path);
+  if (!f) throw ModelError("cannot write " + path);
+  f << j.dump() << '\n';
+  if (!f) throw ModelError("cannot write " + path);
+}
+
+bool StreamSpotter::is_stream_spotter(const std::string& path) {
+  std::ifstream f(path);
+  std::string head(200, '\0');
+  f.read(head.data(), static_cast<std::streamsize>(head.size()));
+  return head.find("\"skelgraph-stream-spotter\"") != std::string::npos;
+}
+
+StreamSpotter StreamSpotter::load(const std::string& path) {
+  std::ifstream f(path);
+  if (!f) throw ModelError("cannot read " + path);
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(f);
+  } catch (const nlohmann::json::exception& e) {
+    throw ModelError(path + ": not JSON: " + e.what());
+  }
+  StreamSpotter s;
+  try {
+    if (j.value("format", "") != "skelgraph-stream-spotter" || j.value("version", 0) != 1)
+      throw ModelError("not a skelgraph-stream-spotter version 1");
+    const auto set = feature_set_from_name(j.at("features").get<std::string>());
+    if (!set) throw ModelError("unknown feature set '" + j.at("features").get<std::string>() + "'");
+    s.features_ = *set;
+    const auto& o = j.at("spotting");
+    s.options_.window_s = o.at("window_s").get<double>();
+    s.options_.positive_offsets_s = o.at("positive_offsets_s").get<std::vector<double>>();
+    s.options_.negative_gap_s = o.at("negative_gap_s").get<double>();
+    s.options_.negative_step_s = o.at("negative_step_s").get<double>();
+    s.options_.step_s = o.at("step_s").get<double>();
+    s.options_.confirm = o.at("confirm").get<int>();
+    s.options_.refractory_s = o.at("refractory_s").get<double>();
+    s.options_.slack_s = o.at("slack_s").get<double>();
+    s.options_.model = o.at("model").get<std::string>();
+    s.options_.knn_k = o.at("knn_k").get<int>();
+    s.options_.knn_samples = o.at("knn_samples").get<int>();
+    s.classes_ = j.at("classes").get<std::vector<std::string>>();
+    s.windows_ = j.at("training_windows").get<std::size_t>();
+    if (j.contains("knn")) s.knn_ = WindowKnn::from_json(j.at("knn"));
+    else if (j.contains("hmm")) s.hmm_ = Classifier::from_json(j.at("hmm"));
+    else throw ModelError("neither 'knn' nor 'hmm'");
+    if (s.options_.step_s <= 0 || s.options_.window_s <= 0) throw ModelError("spotting: window_s and step_s must be > 0");
+  } catch (const nlohmann::json::exception& e) {
+    throw ModelError(path + ": " + e.what());
+  } catch (const ModelError& e) {
+    throw ModelError(path + ": " + e.what());
+  }
+  return s;
 }
 
 StreamSpotting cross_validate_streams(const std::vector<AnnotatedStream>& streams, const ClassifierOptions& c,

@@ -10,6 +10,7 @@
 // Windows end at the newest frame, so the same runs live. No DDS.
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -30,11 +31,11 @@ struct AnnotatedStream {
 
 // A recording with annotations (playback::annotations_of: an
 // .annotations.csv beside it, MSRC-12's .tagstream, per-frame labels) as a
-// stream of features; a ModelError when it has none or the feature set needs
-// wrists it lacks. Ranges are trained on and scored at their end (the gesture
+// stream of features; a ModelError when it has none (unless `require` is
+// false: spotting without scoring) or the feature set needs wrists it lacks. Ranges are trained on and scored at their end (the gesture
 // is complete there); action points are ranges of no length. Subject: the recording's "subject"
 // metadata, else the file name.
-AnnotatedStream annotated_stream(const playback::Recording& recording, const FeatureOptions& features);
+AnnotatedStream annotated_stream(const playback::Recording& recording, const FeatureOptions& features, bool require = true);
 
 struct StreamSpotOptions {
   double window_s = 1.0;                                    // what the classifier sees
@@ -62,11 +63,14 @@ class WindowKnn {
   Decision classify(const Sequence& x) const;
   int garbage_index() const { return garbage_; }
   const std::vector<std::string>& labels() const { return labels_; }
+  nlohmann::json to_json() const;
+  static WindowKnn from_json(const nlohmann::json& j);  // throws ModelError naming the field
 
  private:
+  WindowKnn() = default;
   Eigen::VectorXd vec(const Sequence& x) const;
   std::vector<std::string> labels_;
-  int garbage_ = -1, k_, samples_;
+  int garbage_ = -1, k_ = 5, samples_ = 10;
   Eigen::VectorXd mean_, scale_;
   Eigen::MatrixXd train_;  // one standardised window per column
   std::vector<int> label_;
@@ -90,6 +94,30 @@ struct StreamSpotting {
   std::size_t streams = 0, windows = 0;
   std::vector<std::string> subjects;
   nlohmann::json to_json() const;
+};
+
+// A trained stream spotter: the window classifier, its feature set and the
+// spotting options, saved as JSON ("skelgraph-stream-spotter" version 1) by
+// `gesture train --spot` and used by `gesture spot --model`.
+class StreamSpotter {
+ public:
+  static StreamSpotter train(const std::vector<AnnotatedStream>& streams, const ClassifierOptions& c, const StreamSpotOptions& o);
+  std::vector<SpottedEvent> spot(const AnnotatedStream& s) const;
+  const std::vector<std::string>& classes() const;  // the gestures (garbage left out)
+  FeatureSet feature_set() const { return features_; }
+  const StreamSpotOptions& options() const { return options_; }
+  std::size_t windows() const { return windows_; }
+  void save(const std::string& path) const;
+  static StreamSpotter load(const std::string& path);  // throws ModelError naming the file and field
+  static bool is_stream_spotter(const std::string& path);  // the file says it is one
+
+ private:
+  FeatureSet features_ = FeatureSet::Body;
+  StreamSpotOptions options_;
+  std::vector<std::string> classes_;
+  std::optional<WindowKnn> knn_;
+  std::optional<Classifier> hmm_;
+  std::size_t windows_ = 0;
 };
 
 // Leave-subject-out: for each subject, a classifier trained on the others'
