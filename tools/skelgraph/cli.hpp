@@ -121,6 +121,7 @@ void add_eval_safety_command(CLI::App& eval, Action& run);
 void add_fuse_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_calib_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_gesture_command(CLI::App& app, GlobalOptions& g, Action& run);
+void add_depth_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_oni_command(CLI::App& app, GlobalOptions& g, Action& run);  // with SKELGRAPH_WITH_OPENNI2
 
 // The simulator's configuration from -p KEY=VALUE assignments (then `extra`,

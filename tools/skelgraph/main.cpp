@@ -176,6 +176,7 @@ int main(int argc, char** argv) {
   add_calib_command(app, g, run);
   add_gesture_command(app, g, run);
   add_fuse_command(app, g, run);
+  add_depth_command(app, g, run);
 #ifdef SKELGRAPH_WITH_OPENNI2
   add_oni_command(app, g, run);
 #endif

@@ -1,0 +1,67 @@
+#!/usr/bin/env bash
+# Depth image files as a depth source: the 12 real Kinect images of
+# ../shared/data/skeltrack-depth read and summarised (skelgraph depth info),
+# played on skelgraph/depth (every frame, in order, with its size), driven as a
+# player (paused, stepped, sought), and bad input refused with its file named.
+source "$(dirname "$0")/lib.sh"
+S=$SKELGRAPH
+SK=${SKELGRAPH_DATA_DIR:-$SKELGRAPH_SOURCE_DIR/../shared/data}/skeltrack-depth
+[ -d "$SK" ] || fail "$SK is missing: tests read ../shared/data (or SKELGRAPH_DATA_DIR)"
+
+"$S" depth info "$SK" --width 640 --height 480 --json >"$WORK/info.json" 2>"$WORK/info.err" || fail "depth info: $(cat "$WORK/info.err")"
+json_check "$WORK/info.json" 'd["images"] == d["read"] == 12 and all(f["width"] == 640 and f["height"] == 480 and f["min_mm"] >= 723 and f["max_mm"] <= 1992 and f["valid_share"] > 0.1 for f in d["files"])'
+ok "12 real depth images read: $(json_get "$WORK/info.json" 'min(f["min_mm"] for f in d["files"])')-$(json_get "$WORK/info.json" 'max(f["max_mm"] for f in d["files"])') mm"
+
+# Played: every image once, in name order, 640 x 480, with the images' readings.
+"$S" topic echo skelgraph/depth --count 12 --json --timeout 30 >"$WORK/echo.jsonl" 2>"$WORK/echo.err" &
+echo_pid=$!
+"$S" depth play "$SK" --width 640 --height 480 --rate 15 --json >"$WORK/play.json" 2>"$WORK/play.err" || fail "depth play: $(cat "$WORK/play.err")"
+wait "$echo_pid" || fail "echo: $(cat "$WORK/echo.err")"
+json_check "$WORK/play.json" 'd["components"][0]["details"]["published"] == 12'
+python3 - "$WORK/echo.jsonl" "$WORK/info.json" <<'PY' || fail "played frames: $(cut -c1-300 "$WORK/echo.jsonl")"
+import json, sys
+frames = [json.loads(l)["data"] for l in open(sys.argv[1]) if l.strip()]
+info = json.load(open(sys.argv[2]))
+assert [f["frame_number"] for f in frames] == list(range(12)), [f["frame_number"] for f in frames]
+assert all(f["width"] == 640 and f["height"] == 480 and f["sensor_id"] == "depth1" for f in frames)
+assert [f["depth_mm_valid"] for f in frames] == [f["valid_pixels"] for f in info["files"]]
+PY
+ok "played: 12 frames in order, the readings of each file"
+
+# A player: paused, 3 steps, a seek to 0.5 s (frame 7 at 15 Hz... the last at or before), resumed.
+"$S" depth play "$SK" --width 640 --height 480 --rate 15 --paused --json >"$WORK/step.json" 2>"$WORK/step.err" &
+player=$!
+"$S" player state --json --timeout 10 >"$WORK/st0.json" || fail "player state: $(cat "$WORK/step.err")"
+json_check "$WORK/st0.json" 'd[0]["paused"] and d[0]["frames"] == 0 and d[0]["frame_count"] == 12'
+"$S" topic echo skelgraph/depth --count 3 --json --timeout 15 >"$WORK/steps.jsonl" 2>"$WORK/steps.err" &
+echo_pid=$!
+sleep 2  # the echo's reader matched
+"$S" player step --frames 3 --json >"$WORK/st1.json" || fail "step"
+json_check "$WORK/st1.json" 'd[0]["paused"] and d[0]["frames"] == 3'
+wait "$echo_pid" || fail "echo of the steps: $(cat "$WORK/steps.err")"
+python3 -c 'import json, sys; n = [json.loads(l)["data"]["frame_number"] for l in open(sys.argv[1])]; sys.exit(n != [0, 1, 2])' \
+  "$WORK/steps.jsonl" || fail "stepped frames: $(cut -c1-200 "$WORK/steps.jsonl")"
+"$S" player seek 0.5 --json >"$WORK/st2.json" || fail "seek"
+json_check "$WORK/st2.json" 'd[0]["paused"] and abs(d[0]["position_s"] - 7 / 15) < 1e-6'
+"$S" player resume >/dev/null
+wait "$player" || fail "player: $(cat "$WORK/step.err")"
+json_check "$WORK/step.json" 'd["components"][0]["details"]["published"] == 3 + 5'
+ok "paused, stepped frames 0-1-2, sought to 0.5 s (frame 7), played the 5 after it"
+
+# Bad input: named, exit 2.
+rc=0
+"$S" depth info "$SK" >/dev/null 2>"$WORK/bad1.err" || rc=$?
+[ "$rc" -eq 2 ] && grep -q "needs the image size" "$WORK/bad1.err" || fail "raw without a size: rc $rc, $(cat "$WORK/bad1.err")"
+mkdir -p "$WORK/mixed"
+cp "$SK"/depth-data-82823944 "$WORK/mixed/a.raw"
+head -c 1000 "$SK"/depth-data-82823944 >"$WORK/mixed/b.raw"
+rc=0
+"$S" depth info "$WORK/mixed" --width 640 --height 480 --json >"$WORK/mixed.json" 2>"$WORK/bad2.err" || rc=$?
+[ "$rc" -eq 2 ] || fail "a truncated image: exit $rc, expected 2"
+grep -q "b.raw: 1000 bytes; a raw 640 x 480 uint16 image has 614400" "$WORK/bad2.err" || fail "truncated: $(cat "$WORK/bad2.err")"
+json_check "$WORK/mixed.json" 'd["read"] == 1 and "error" in d["files"][1]'
+rc=0
+"$S" depth play "$WORK/mixed" --width 640 --height 480 --duration 30 >"$WORK/bad3.out" 2>"$WORK/bad3.err" || rc=$?
+[ "$rc" -eq 1 ] || fail "played a folder whose second image is truncated: exit $rc, expected 1 (the component in ERROR)"
+grep -q "ERROR - .*b.raw: 1000 bytes" "$WORK/bad3.out" "$WORK/bad3.err" || fail "the truncated image is not named: $(cat "$WORK/bad3.out" "$WORK/bad3.err")"
+ok "bad input named: a raw image without a size, a truncated one"
