@@ -7,8 +7,11 @@
 #include <iomanip>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <tuple>
+
+#include <yaml-cpp/yaml.h>
 
 #include <nlohmann/json.hpp>
 
@@ -19,6 +22,7 @@
 #include "skelgraph/msg/cdr.hpp"
 #include "skelgraph/msg/json.hpp"
 #include "skelgraph/msg/schema.hpp"
+#include "skelgraph/playback/bvh.hpp"
 #include "skelgraph/playback/readers.hpp"
 #include "skelgraph/recording/bag.hpp"
 #include "skelgraph/recording/session_recorder.hpp"
@@ -228,6 +232,88 @@ int import(playback::Format format, const std::vector<std::string>& files, const
   bag.close();
   if (json) std::printf("%s\n", nlohmann::json{{"out", out}, {"frames", frames}, {"files", files}}.dump(2).c_str());
   else std::printf("%s: %llu skeletons from %zu file(s)\n", out.c_str(), static_cast<unsigned long long>(frames), files.size());
+  return 0;
+}
+
+struct MocapOptions {
+  std::string file, out, add_to, transform, mapping, units = "cm", frame_id = "world";
+  std::optional<double> time_offset;
+  bool json = false;
+};
+
+// A rigid transform file (YAML): rotation: [9 numbers, row-major], translation: [x, y, z] metres.
+Eigen::Isometry3d read_transform(const std::string& path) {
+  YAML::Node y;
+  try {
+    y = YAML::LoadFile(path);
+  } catch (const YAML::Exception& e) {
+    throw UsageError(path + ": not a readable YAML file: " + e.msg);
+  }
+  const auto r = y["rotation"], t = y["translation"];
+  if (!r || !r.IsSequence() || r.size() != 9 || !t || !t.IsSequence() || t.size() != 3)
+    throw UsageError(path + ": expected rotation: [9 numbers, row-major] and translation: [x, y, z] (metres)");
+  Eigen::Matrix3d m;
+  for (int i = 0; i < 9; ++i) m(i / 3, i % 3) = r[static_cast<std::size_t>(i)].as<double>();
+  if (!(m * m.transpose()).isApprox(Eigen::Matrix3d::Identity(), 1e-6) || m.determinant() < 0)
+    throw UsageError(path + ": the rotation is not a rotation (orthonormal, determinant 1)");
+  Eigen::Isometry3d iso = Eigen::Isometry3d::Identity();
+  iso.linear() = m;
+  iso.translation() = Eigen::Vector3d(t[0].as<double>(), t[1].as<double>(), t[2].as<double>());
+  return iso;
+}
+
+// Motion capture (BVH) as ground truth on skelgraph/skeleton/truth, alone or
+// added to a copy of a recording (so `eval recording` scores it against the mocap).
+int import_bvh(const MocapOptions& o) {
+  playback::BvhOptions b;
+  b.units_to_m = o.units == "mm" ? 0.001 : o.units == "m" ? 1.0 : o.units == "in" ? 0.0254 : 0.01;
+  if (!o.transform.empty()) b.target_from_mocap = read_transform(o.transform);
+  if (!o.mapping.empty()) b.joints = user_input([&] { return playback::read_bvh_mapping(o.mapping); });
+  b.frame_id = o.frame_id;
+  mcap::WriterOptions wo;
+  wo.compression = mcap::Compression::Zstd;
+  recording::BagWriter bag(o.out, wo);
+  std::uint64_t copied = 0;
+  std::optional<std::uint64_t> first;
+  if (!o.add_to.empty()) {
+    const mcap::Reader reader = user_input([&] { return mcap::Reader(o.add_to); });
+    std::map<std::uint16_t, std::uint16_t> channels;
+    for (const auto& m : user_input([&] { return reader.summary(); }).metadata) bag.write_metadata(m.name, m.values);
+    user_input([&] {
+      reader.for_each_message([&](const mcap::Channel& ch, const mcap::Schema* schema, const mcap::Message& m) {
+        if (ch.topic == runtime::topics::kSkeletonTruth.name) return;  // replaced by the mocap
+        auto& mapped = channels[ch.id];
+        if (mapped == 0) {
+          const auto sid = schema ? bag.mcap().add_schema(schema->name, schema->encoding, schema->data) : std::uint16_t{0};
+          mapped = bag.mcap().add_channel(sid, ch.topic, ch.message_encoding, ch.metadata);
+        }
+        mcap::Message copy = m;
+        copy.channel_id = mapped;
+        bag.mcap().write(copy);
+        ++copied;
+        if (!first || m.log_time < *first) first = m.log_time;
+      });
+    });
+  }
+  b.time_offset_s = o.time_offset ? *o.time_offset : first ? 1e-9 * static_cast<double>(*first) : 0.0;
+  const auto rec = user_input([&] { return playback::bvh_recording(o.file, playback::read_bvh(o.file), b); });
+  for (const auto& s : rec.frames) {
+    if (s.stamp_ns < 0) throw UsageError(o.file + ": negative time stamp; give --time-offset");
+    const auto t = static_cast<std::uint64_t>(s.stamp_ns);
+    bag.write(runtime::topics::kSkeletonTruth.name, skeleton::to_msg(s), t, t);
+  }
+  bag.write_metadata("mocap", {{"source", o.file}, {"units", o.units}, {"frame_id", o.frame_id}, {"joints", rec.metadata.at("joints")}});
+  bag.close();
+  const double span = rec.frames.size() > 1 ? 1e-9 * static_cast<double>(rec.frames.back().stamp_ns - rec.frames.front().stamp_ns) : 0.0;
+  if (o.json)
+    std::printf("%s\n", nlohmann::json{{"out", o.out}, {"truth_frames", rec.frames.size()}, {"span_s", span}, {"copied", copied},
+                                       {"time_offset_s", b.time_offset_s}}
+                            .dump(2)
+                            .c_str());
+  else
+    std::printf("%s: %zu mocap frames (%.1f s) on %s%s\n", o.out.c_str(), rec.frames.size(), span,
+                runtime::topics::kSkeletonTruth.name,
+                o.add_to.empty() ? "" : (", with the " + std::to_string(copied) + " messages of " + o.add_to).c_str());
   return 0;
 }
 
@@ -606,6 +692,24 @@ void add_bag_command(CLI::App& app, GlobalOptions& g, Action& run) {
                     *mcap::compression_from_name(o->compression), o->json);
     };
   });
+
+  auto mo = std::make_shared<MocapOptions>();
+  auto* ib = bag->add_subcommand("import-bvh", "Motion capture (BVH) as ground truth on skelgraph/skeleton/truth, alone or added "
+                                              "to a copy of a recording, so `eval recording` scores the recording against it");
+  ib->add_option("file", mo->file, "BVH file")->required()->check(CLI::ExistingFile);
+  ib->add_option("--out", mo->out, "MCAP file to write")->required();
+  ib->add_option("--add-to", mo->add_to, "a recording copied into --out first (its own truth left out)")->check(CLI::ExistingFile);
+  ib->add_option("--units", mo->units, "the BVH's length unit: cm (default), mm, m, in")->check(CLI::IsMember({"cm", "mm", "m", "in"}));
+  ib->add_option("--transform", mo->transform,
+                 "the mocap frame into the target frame: YAML with rotation: [9, row-major] and translation: [x, y, z] metres")
+      ->check(CLI::ExistingFile);
+  ib->add_option("--frame-id", mo->frame_id, "the frame the positions end up in (default world; a sensor's id for its frame)");
+  ib->add_option("--time-offset", mo->time_offset,
+                 "frame 0's time, seconds on the recording's clock (default: the --add-to recording's first message, else 0)");
+  ib->add_option("--mapping", mo->mapping, "YAML joints: {head: NAME, ...} for names the default mapping does not know")
+      ->check(CLI::ExistingFile);
+  ib->add_flag("--json", mo->json, "machine-readable summary");
+  ib->callback([mo, &run] { run = [mo] { return import_bvh(*mo); }; });
 
   auto* ex = bag->add_subcommand("export", "Skeletons of a recording to CSV files, one per topic and sensor; or with --scene the "
                                           "recording with the cell as a 3-D scene for Foxglove/Lichtblick added");

@@ -15,6 +15,7 @@
 
 #include "skelgraph/calib/board.hpp"
 #include "skelgraph/calib/calib_file.hpp"
+#include "skelgraph/playback/bvh.hpp"
 #include "skelgraph/playback/readers.hpp"
 #include "skelgraph/recording/bag.hpp"
 #include "skelgraph/runtime/topics.hpp"
@@ -437,6 +438,27 @@ int export_run(const std::vector<std::string>& assignments, const std::string& d
     write_file(std::filesystem::path(dir) / name, raw[i]);
     files[name] = raw[i].frames.size();
   }
+  // The truth as motion capture (BVH, cm, position channels): what `bag
+  // import-bvh` reads, when one person is there from start to end at the truth rate.
+  const auto evenly = [&] {
+    if (truth.frames.size() < 2) return false;
+    const auto step_ns = truth.frames[1].stamp_ns - truth.frames[0].stamp_ns;
+    for (std::size_t i = 1; i < truth.frames.size(); ++i) {
+      const auto d = truth.frames[i].stamp_ns - truth.frames[i - 1].stamp_ns;
+      if (truth.frames[i].person_id != truth.frames[0].person_id || std::llabs(d - step_ns) > 1'000'000) return false;
+    }
+    return true;
+  };
+  if (evenly()) {
+    std::ofstream bvh(std::filesystem::path(dir) / "truth.bvh");
+    playback::write_position_bvh(truth.frames, 1e-9 * static_cast<double>(truth.frames[1].stamp_ns - truth.frames[0].stamp_ns), 100.0,
+                                 bvh);
+    if (!bvh.flush()) throw std::runtime_error("error writing truth.bvh");
+    files["truth.bvh"] = truth.frames.size();
+    files["truth.bvh first frame s"] = 1e-9 * static_cast<double>(truth.frames.front().stamp_ns);
+  } else {
+    files["truth.bvh"] = "not written: not one person from start to end at a steady rate";
+  }
   if (!phases.flush()) throw std::runtime_error("error writing phases.csv");
   files["phases.csv"] = truth.frames.size();
   if (json) {
@@ -482,7 +504,7 @@ void add_sim_command(CLI::App& app, GlobalOptions&, Action& run) {
   h->callback([ho, &run] { run = [ho] { return write_hand_at_tool(*ho); }; });
 
   auto e = std::make_shared<ExportOpts>();
-  auto* x = cmd->add_subcommand("export", "Run a simulation offline and write it as generic CSV (truth, each sensor, phases)");
+  auto* x = cmd->add_subcommand("export", "Run a simulation offline and write it as generic CSV (truth, each sensor, phases), and the truth as motion capture (truth.bvh)");
   x->add_option("directory", e->dir, "output directory (created)")->required();
   x->add_option("-p,--param", e->params, "sim parameter as KEY=VALUE, as in `skelgraph components` (repeatable)");
   x->add_flag("--json", e->json, "machine-readable summary");
