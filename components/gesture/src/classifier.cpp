@@ -389,15 +389,18 @@ void Classifier::save(const std::string& path) const {
   if (!f) throw ModelError("cannot write " + path);
 }
 
-Classifier Classifier::load(const std::string& path) {
+nlohmann::json read_model_json(const std::string& path) {
   std::ifstream f(path);
   if (!f) throw ModelError("cannot read " + path);
-  nlohmann::json j;
   try {
-    j = nlohmann::json::parse(f);
+    return nlohmann::json::parse(f);
   } catch (const nlohmann::json::exception& e) {
     throw ModelError(path + ": not JSON: " + e.what());
   }
+}
+
+Classifier Classifier::load(const std::string& path) {
+  const auto j = read_model_json(path);
   try {
     return from_json(j);
   } catch (const ModelError& e) {

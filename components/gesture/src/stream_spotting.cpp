@@ -291,14 +291,7 @@ bool StreamSpotter::is_stream_spotter(const std::string& path) {
 }
 
 StreamSpotter StreamSpotter::load(const std::string& path) {
-  std::ifstream f(path);
-  if (!f) throw ModelError("cannot read " + path);
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(f);
-  } catch (const nlohmann::json::exception& e) {
-    throw ModelError(path + ": not JSON: " + e.what());
-  }
+  const auto j = read_model_json(path);
   StreamSpotter s;
   try {
     if (j.value("format", "") != "skelgraph-stream-spotter" || j.value("version", 0) != 1)

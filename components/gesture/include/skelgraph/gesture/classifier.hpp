@@ -40,6 +40,9 @@ struct ClassMap {
   nlohmann::json to_json() const;
 };
 
+// A model file's JSON; ModelError naming the file when it cannot be read or is not JSON.
+nlohmann::json read_model_json(const std::string& path);
+
 // One labelled recording: its features and where it came from.
 struct Clip {
   std::string source;   // file
