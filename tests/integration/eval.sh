@@ -130,6 +130,9 @@ t0=$(json_get "$WORK/mocap_export.json" 'd["rows"]["truth.bvh first frame s"]')
 "$SKELGRAPH" bag import-bvh "$WORK/mocap/truth.bvh" --add-to "$WORK/mocap_raw.mcap" --time-offset "$t0" --out "$WORK/mocap.mcap" \
   --json >"$WORK/mocap_import.json" || fail "bag import-bvh"
 json_check "$WORK/mocap_import.json" 'd["truth_frames"] > 100 and d["copied"] > 100'
+rc=0
+"$SKELGRAPH" bag import-bvh "$WORK/mocap/truth.bvh" --transform "$WORK/mocap_poses.yaml" --out "$WORK/x.mcap" 2>"$WORK/mocap_bad.err" || rc=$?
+[ "$rc" -eq 2 ] && grep -q "no sensor 'mocap'" "$WORK/mocap_bad.err" || fail "a calibration file without the mocap's pose: rc $rc, $(cat "$WORK/mocap_bad.err")"
 "$SKELGRAPH" eval recording "$WORK/mocap.mcap" --calibration "$WORK/mocap_poses.yaml" --json >"$WORK/mocap_eval.json" \
   || fail "eval recording against the mocap"
 python3 - "$WORK/mocap_eval.json" <<'PY' || fail "scored against the mocap: $(head -c 1500 "$WORK/mocap_eval.json")"

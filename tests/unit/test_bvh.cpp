@@ -98,6 +98,15 @@ TEST(Bvh, SimulatorTruthRoundTrips) {
   } catch (const DataError& e) {
     EXPECT_NE(std::string(e.what()).find("'Skull' (for head) is not a joint of this file"), std::string::npos) << e.what();
   }
+  // Matched moments: a mocap clock 1 % fast, frame 0 at 50 s.
+  o.joints.clear();
+  const auto points = read_bvh_time_points(write_file("points.csv", "mocap_frame,time_s\n0,50\n100,53.3\n"));
+  ASSERT_EQ(points.size(), 2u);
+  o.time_points = points;
+  const auto timed = bvh_recording(path, b, o);
+  EXPECT_EQ(timed.frames[0].stamp_ns, 50'000'000'000);
+  EXPECT_NEAR(static_cast<double>(timed.frames[100].stamp_ns) * 1e-9, 53.3, 1e-6);
+  EXPECT_THROW(read_bvh_time_points(write_file("points2.csv", "frame,t\n")), DataError);
   // A mapping file.
   const auto m = read_bvh_mapping(write_file("map.yaml", "joints:\n  head: Head\n  torso: Spine1\n"));
   EXPECT_EQ(m.at("torso"), "Spine1");

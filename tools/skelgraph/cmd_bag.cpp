@@ -22,6 +22,7 @@
 #include "skelgraph/msg/cdr.hpp"
 #include "skelgraph/msg/json.hpp"
 #include "skelgraph/msg/schema.hpp"
+#include "skelgraph/calib/calib_file.hpp"
 #include "skelgraph/playback/bvh.hpp"
 #include "skelgraph/playback/readers.hpp"
 #include "skelgraph/recording/bag.hpp"
@@ -236,18 +237,33 @@ int import(playback::Format format, const std::vector<std::string>& files, const
 }
 
 struct MocapOptions {
-  std::string file, out, add_to, transform, mapping, units = "cm", frame_id = "world";
+  std::string file, out, add_to, transform, mapping, units = "cm", frame_id = "world", mocap_id = "mocap", time_points;
   std::optional<double> time_offset;
   bool json = false;
 };
 
-// A rigid transform file (YAML): rotation: [9 numbers, row-major], translation: [x, y, z] metres.
-Eigen::Isometry3d read_transform(const std::string& path) {
+// A rigid transform file (YAML): rotation: [9 numbers, row-major], translation: [x, y, z] metres;
+// or a calibration file, whose sensor `mocap_id` is the motion-capture system's pose in its frame.
+Eigen::Isometry3d read_transform(const std::string& path, const std::string& mocap_id) {
   YAML::Node y;
   try {
     y = YAML::LoadFile(path);
   } catch (const YAML::Exception& e) {
     throw UsageError(path + ": not a readable YAML file: " + e.msg);
+  }
+  if (y["sensors"]) {
+    calib::CalibFile c;
+    try {
+      c = calib::read_calib_file(path);
+    } catch (const std::exception& e) {
+      throw UsageError(e.what());
+    }
+    std::string ids;
+    for (const auto& s : c.sensors) {
+      if (s.sensor_id == mocap_id) return s.pose;
+      ids += (ids.empty() ? "" : ", ") + s.sensor_id;
+    }
+    throw UsageError(path + ": no sensor '" + mocap_id + "' (the motion-capture system's pose; --mocap-id) among " + ids);
   }
   const auto r = y["rotation"], t = y["translation"];
   if (!r || !r.IsSequence() || r.size() != 9 || !t || !t.IsSequence() || t.size() != 3)
@@ -267,7 +283,8 @@ Eigen::Isometry3d read_transform(const std::string& path) {
 int import_bvh(const MocapOptions& o) {
   playback::BvhOptions b;
   b.units_to_m = o.units == "mm" ? 0.001 : o.units == "m" ? 1.0 : o.units == "in" ? 0.0254 : 0.01;
-  if (!o.transform.empty()) b.target_from_mocap = read_transform(o.transform);
+  if (!o.transform.empty()) b.target_from_mocap = read_transform(o.transform, o.mocap_id);
+  if (!o.time_points.empty()) b.time_points = user_input([&] { return playback::read_bvh_time_points(o.time_points); });
   if (!o.mapping.empty()) b.joints = user_input([&] { return playback::read_bvh_mapping(o.mapping); });
   b.frame_id = o.frame_id;
   mcap::WriterOptions wo;
@@ -701,11 +718,18 @@ void add_bag_command(CLI::App& app, GlobalOptions& g, Action& run) {
   ib->add_option("--add-to", mo->add_to, "a recording copied into --out first (its own truth left out)")->check(CLI::ExistingFile);
   ib->add_option("--units", mo->units, "the BVH's length unit: cm (default), mm, m, in")->check(CLI::IsMember({"cm", "mm", "m", "in"}));
   ib->add_option("--transform", mo->transform,
-                 "the mocap frame into the target frame: YAML with rotation: [9, row-major] and translation: [x, y, z] metres")
+                 "the mocap frame into the target frame: YAML with rotation: [9, row-major] and translation: [x, y, z] metres, "
+                 "or a calibration file with the motion-capture system as a sensor (--mocap-id)")
       ->check(CLI::ExistingFile);
   ib->add_option("--frame-id", mo->frame_id, "the frame the positions end up in (default world; a sensor's id for its frame)");
   ib->add_option("--time-offset", mo->time_offset,
                  "frame 0's time, seconds on the recording's clock (default: the --add-to recording's first message, else 0)");
+  ib->add_option("--mocap-id", mo->mocap_id, "with a calibration file as --transform: the motion-capture system's entry (default mocap)");
+  ib->add_option("--time-points", mo->time_points,
+                 "CSV mocap_frame,time_s: matched moments (recording clock, s); frame times follow the line through them "
+                 "(instead of --time-offset and the file's frame time)")
+      ->check(CLI::ExistingFile)
+      ->excludes("--time-offset");
   ib->add_option("--mapping", mo->mapping, "YAML joints: {head: NAME, ...} for names the default mapping does not know")
       ->check(CLI::ExistingFile);
   ib->add_flag("--json", mo->json, "machine-readable summary");

@@ -196,6 +196,21 @@ const std::map<std::string, std::vector<std::string>>& default_bvh_mapping() {
   return m;
 }
 
+std::vector<std::pair<std::size_t, double>> read_bvh_time_points(const std::string& path) {
+  CsvReader csv(path);
+  std::vector<std::string> f;
+  if (!csv.next(f) || f != std::vector<std::string>{"mocap_frame", "time_s"}) csv.fail("expected the header 'mocap_frame,time_s'");
+  std::vector<std::pair<std::size_t, double>> out;
+  while (csv.next(f)) {
+    if (f.size() != 2) csv.fail("expected 2 fields (mocap_frame, time_s), got " + std::to_string(f.size()));
+    const auto frame = csv.integer(f, 0, "mocap_frame");
+    if (frame < 0) csv.fail("mocap_frame must not be negative");
+    out.emplace_back(static_cast<std::size_t>(frame), csv.number(f, 1, "time_s"));
+  }
+  if (out.empty()) csv.fail("no matched moments");
+  return out;
+}
+
 std::map<std::string, std::string> read_bvh_mapping(const std::string& path) {
   YAML::Node y;
   try {
@@ -240,7 +255,28 @@ Recording bvh_recording(const std::string& path, const Bvh& bvh, const BvhOption
     }
     index[k] = found;
   }
-  const auto t0 = static_cast<std::int64_t>(std::llround(o.time_offset_s * 1e9));
+  // Frame f's time: t0 + rate * f.
+  double t0 = o.time_offset_s, rate = bvh.frame_time_s;
+  if (o.time_points.size() == 1) {
+    t0 = o.time_points[0].second - static_cast<double>(o.time_points[0].first) * bvh.frame_time_s;
+  } else if (o.time_points.size() > 1) {
+    double mf = 0, mt = 0;
+    for (const auto& [f, t] : o.time_points) {
+      mf += static_cast<double>(f);
+      mt += t;
+    }
+    mf /= static_cast<double>(o.time_points.size());
+    mt /= static_cast<double>(o.time_points.size());
+    double sff = 0, sft = 0;
+    for (const auto& [f, t] : o.time_points) {
+      sff += (static_cast<double>(f) - mf) * (static_cast<double>(f) - mf);
+      sft += (static_cast<double>(f) - mf) * (t - mt);
+    }
+    if (!(sff > 0)) throw DataError(path, 0, "the matched moments name one mocap frame only");
+    rate = sft / sff;
+    if (!(rate > 0)) throw DataError(path, 0, "the matched moments put later mocap frames earlier");
+    t0 = mt - rate * mf;
+  }
   for (std::size_t f = 0; f < bvh.frames.size(); ++f) {
     const auto p = bvh.positions(f);
     skeleton::Skeleton s;
@@ -248,7 +284,7 @@ Recording bvh_recording(const std::string& path, const Bvh& bvh, const BvhOption
     s.frame_id = o.frame_id;
     s.person_id = 1;
     s.frame_number = f;
-    s.stamp_ns = t0 + static_cast<std::int64_t>(std::llround(static_cast<double>(f) * bvh.frame_time_s * 1e9));
+    s.stamp_ns = static_cast<std::int64_t>(std::llround((t0 + rate * static_cast<double>(f)) * 1e9));
     for (std::size_t k = 0; k < skeleton::kJointCount; ++k) {
       s.joints[k].position = o.target_from_mocap * (o.units_to_m * p[static_cast<std::size_t>(index[k])]);
       s.joints[k].confidence = skeleton::kTracked;

@@ -55,11 +55,19 @@ struct BvhOptions {
   std::string frame_id = "world";    // the frame the positions end up in
   std::string sensor_id = "mocap";
   double time_offset_s = 0.0;        // frame 0's time (the recording's clock)
+  // Matched moments (mocap frame, its time on the recording's clock, s): when
+  // given, frame f's time is the least-squares line through them (one point:
+  // that time and the file's frame time), so a mocap clock running at another
+  // rate is followed; time_offset_s is then not used.
+  std::vector<std::pair<std::size_t, double>> time_points;
   std::map<std::string, std::string> joints;  // canonical name -> BVH joint; empty: the default mapping
 };
 
 // The default mapping's candidates per canonical joint (the first one the file has wins).
 const std::map<std::string, std::vector<std::string>>& default_bvh_mapping();
+// Matched moments, CSV with the header `mocap_frame,time_s`; throws DataError naming file:line.
+std::vector<std::pair<std::size_t, double>> read_bvh_time_points(const std::string& path);
+
 // A mapping YAML file: `joints: {head: Head, left_hand: LeftHand, ...}`
 // (canonical names as in skeleton.hpp); throws DataError naming the file.
 std::map<std::string, std::string> read_bvh_mapping(const std::string& path);
