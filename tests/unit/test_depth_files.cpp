@@ -98,7 +98,7 @@ TEST(DepthFiles, BadFilesSayWhatWasExpected) {
   EXPECT_NE(error_of(d / "text.pgm", {}).find("expected a binary PGM ('P5'), got 'P2'"), std::string::npos);
   cv::Mat eight(2, 2, CV_8UC1, cv::Scalar(7));
   ASSERT_TRUE(cv::imwrite((d / "eight.png").string(), eight));
-  EXPECT_NE(error_of(d / "eight.png", {}).find("eight.png: a 8-bit image with 1 channel(s); expected 16-bit"), std::string::npos);
+  EXPECT_NE(error_of(d / "eight.png", {}).find("eight.png: an 8-bit image with 1 channel(s); expected 16-bit"), std::string::npos);
   write_raw(d / "odd.raw", ramp(3, 3));
   EXPECT_NE(error_of(d / "odd.raw", sized(4, 3)).find("odd.raw: 18 bytes; a raw 4 x 3 uint16 image has 24"),
             std::string::npos);
@@ -140,6 +140,23 @@ TEST(DepthFiles, AFolderInNameOrderWithTimesAndIntrinsics) {
   }
   o.timestamps.clear();
   o.pattern = "[ab]\\.pgm";
+  // A raw file of the wrong size is found without reading it (a player refuses the folder before it plays).
+  {
+    const auto r = fresh_dir("depth_raw_sizes");
+    write_raw(r / "a.raw", ramp(4, 3));
+    write_raw(r / "b.raw", ramp(4, 2));
+    DepthFilesOptions ro;
+    ro.width = 4;
+    ro.height = 3;
+    const DepthFolder folder(r.string(), ro);
+    EXPECT_NO_THROW(folder.read(0));
+    try {
+      folder.check_raw_sizes();
+      ADD_FAILURE() << "a short raw file was taken";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("b.raw: 16 bytes; a raw 4 x 3 uint16 image has 24"), std::string::npos) << e.what();
+    }
+  }
   EXPECT_EQ(DepthFolder(d.string(), o).size(), 2u);
   // An intrinsics file for another size is refused when the image is read.
   skelgraph::calib::Intrinsics k;  // 640 x 480

@@ -68,7 +68,8 @@ std::vector<std::uint16_t> read_png(const std::string& path, int& width, int& he
   const cv::Mat m = cv::imread(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_GRAYSCALE);
   if (m.empty()) bad(path, "not a PNG image OpenCV can read");
   if (m.depth() != CV_16U || m.channels() != 1)
-    bad(path, "a " + std::to_string(m.elemSize1() * 8) + "-bit image with " + std::to_string(m.channels()) +
+    bad(path, std::string(m.elemSize1() == 1 ? "an " : "a ") + std::to_string(m.elemSize1() * 8) + "-bit image with " +
+                  std::to_string(m.channels()) +
                   " channel(s); expected 16-bit single-channel depth");
   width = m.cols;
   height = m.rows;
@@ -169,6 +170,19 @@ DepthFolder::DepthFolder(const std::string& directory, DepthFilesOptions options
   if (!o_.intrinsics_file.empty()) {
     o_.intrinsics = calib::read_intrinsics_file(o_.intrinsics_file);
     o_.intrinsics_given = true;
+  }
+}
+
+void DepthFolder::check_raw_sizes() const {
+  for (const auto& f : files_) {
+    const auto ext = lower_ext(f);
+    const bool raw = o_.format == "raw" || (o_.format == "auto" && ext != ".pgm" && ext != ".png");
+    if (!raw || o_.width <= 0 || o_.height <= 0) continue;
+    const auto bytes = fs::file_size(f);
+    const auto want = static_cast<std::uintmax_t>(o_.width) * static_cast<std::uintmax_t>(o_.height) * 2;
+    if (bytes != want)
+      bad(f, std::to_string(bytes) + " bytes; a raw " + std::to_string(o_.width) + " x " + std::to_string(o_.height) +
+                 " uint16 image has " + std::to_string(want));
   }
 }
 

@@ -57,6 +57,7 @@ DepthFilesComponent::DepthFilesComponent(runtime::Context& ctx, const runtime::P
   hold_at_end_ = params.get<bool>("hold_at_end");
   wait_s_ = params.get<double>("wait_s");
   folder_ = std::make_unique<DepthFolder>(dir, o);
+  folder_->check_raw_sizes();
   // The first image now: bad files and sizes are refused before the graph starts.
   const auto first = folder_->read(0);
   if (fx > 0) {

@@ -49,6 +49,10 @@ class DepthFolder {
   // Image i with its intrinsics and frame number (stamp_ns left 0: the player stamps it).
   DepthImage read(std::size_t i) const;
   const DepthFilesOptions& options() const { return o_; }
+  // Raw files' byte counts against the size, without reading them: throws
+  // std::invalid_argument naming the first that does not fit (a player
+  // refuses such a folder before it plays anything).
+  void check_raw_sizes() const;
 
  private:
   DepthFilesOptions o_;
