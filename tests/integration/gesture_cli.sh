@@ -169,7 +169,18 @@ json_check "$WORK/stream_train.json" 'd["streams"] == 4 and len(d["classes"]) ==
 "$S" gesture spot --model "$WORK/stream_model.json" --format msrc12 "$MS"/P1_1_1_p21.csv "$MS"/P1_1_12_p21.csv --json \
   >"$WORK/stream_spot.json" 2>"$WORK/stream_spot.err" || fail "spot --model: $(cat "$WORK/stream_spot.err")"
 json_check "$WORK/stream_spot.json" 'len(d["files"]) == 2 and all(len(f["events"]) > 3 for f in d["files"]) and [c["truth"] for c in d["per_class"]] == [11, 11] and d["macro_f1"] > 0.7'
-rc=0
-"$S" gesture spot --model "$WORK/model.json" --format msrc12 "$MS"/P1_1_1_p21.csv >/dev/null 2>"$WORK/not_stream.err" || rc=$?
-[ "$rc" -eq 2 ] && grep -q "not a stream spotter" "$WORK/not_stream.err" || fail "a clip classifier given to spot --model: rc $rc, $(cat "$WORK/not_stream.err")"
+# A clip classifier (not a stream spotter) runs through the live spotter instead.
+"$S" gesture spot --model "$WORK/model.json" --format msrc12 "$MS"/P1_1_1_p21.csv --json >"$WORK/clip_model.json" \
+  2>"$WORK/clip_model.err" || fail "a clip classifier given to spot --model: $(cat "$WORK/clip_model.err")"
+json_check "$WORK/clip_model.json" 'len(d["files"]) == 1 and "events_per_hour" in d'
 ok "stream spotter trained on two people, spotting the third's streams: macro F1 $(json_get "$WORK/stream_spot.json" 'round(d["macro_f1"], 3)')"
+
+# A clip classifier through the live spotter over recordings where nobody
+# points (MSRC-12's gestures): events listed per file and counted per hour.
+"$S" gesture spot --model sim --format msrc12 "$MS"/P1_1_10_p06.csv "$MS"/P1_1_12_p19.csv --json >"$WORK/quiet.json" \
+  2>"$WORK/quiet.err" || fail "spot --model sim: $(cat "$WORK/quiet.err")"
+json_check "$WORK/quiet.json" 'len(d["files"]) == 2 and d["seconds"] > 100 and all(f["span_s"] > 20 for f in d["files"]) and sum(len(f["events"]) for f in d["files"]) == round(sum(d["events_per_hour"].values()) * d["seconds"] / 3600)'
+rc=0
+"$S" gesture spot --model nosuch --format msrc12 "$MS"/P1_1_10_p06.csv >/dev/null 2>"$WORK/nosuch.err" || rc=$?
+[ "$rc" -eq 2 ] || fail "an unknown model was taken: exit $rc"
+ok "the built-in pointing model over MSRC-12 streams: $(json_get "$WORK/quiet.json" 'd["events_per_hour"]') events per hour"

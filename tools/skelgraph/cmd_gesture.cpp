@@ -17,6 +17,7 @@
 #include "skelgraph/gesture/classifier.hpp"
 #include "skelgraph/gesture/clip_spotting.hpp"
 #include "skelgraph/gesture/dataset.hpp"
+#include "skelgraph/gesture/builtin_models.hpp"
 #include "skelgraph/gesture/sim_sessions.hpp"
 #include "skelgraph/gesture/stream_spotting.hpp"
 #include "skelgraph/gesture/spotter.hpp"
@@ -249,9 +250,59 @@ int gesture_train_streams(const GestureOptions& o) {
 }
 
 // spot --model: a saved stream spotter over recordings; scored where they have annotations.
+// spot --model with a clip classifier (`gesture train`, `gesture sim --out`,
+// the built-in `sim`): the live component's spotter over each recording's
+// people, its events listed and counted per hour (false alarms, where nobody
+// makes the model's gestures).
+int gesture_spot_classifier(const GestureOptions& o) {
+  const auto model = is_builtin_model(o.model) ? load_builtin_model(o.model) : Classifier::load(o.model);
+  const auto format = *playback::format_from_name(o.format);
+  BadInputs bad;
+  nlohmann::json files = nlohmann::json::array();
+  std::map<std::string, std::size_t> by_label;
+  double seconds = 0;
+  const auto paths = expand_paths(o.inputs);
+  for (const auto& file : paths) {
+    playback::Recording rec;
+    if (!bad.guard([&] { rec = playback::read_recording(format, file, read_options(o)); })) continue;
+    note_skipped(rec);
+    const auto wrists = wrists_of(rec);
+    if (needs_wrists(model.feature_set()) && wrists.empty())
+      throw UsageError(file + ": the model's '" + feature_set_name(model.feature_set()) + "' features need wrists; this recording has none");
+    std::map<std::pair<std::string, std::uint32_t>, Spotter> spotters;
+    nlohmann::json ev = nlohmann::json::array();
+    const auto t0 = rec.frames.front().stamp_ns;
+    for (std::size_t i = 0; i < rec.frames.size(); ++i) {
+      const auto& s = rec.frames[i];
+      auto& sp = spotters.try_emplace({s.sensor_id, s.person_id}, model, o.spot).first->second;
+      for (const auto& e : sp.step(s, wrists.empty() ? nullptr : &wrists[i])) {
+        ev.push_back({{"label", e.label}, {"person_id", e.person_id}, {"time_s", 1e-9 * static_cast<double>(e.end_ns - t0)},
+                      {"confidence", e.confidence}});
+        ++by_label[e.label];
+      }
+    }
+    const double span = 1e-9 * static_cast<double>(rec.frames.back().stamp_ns - t0);
+    seconds += span;
+    if (!o.json) std::printf("%s: %zu events in %.1f s\n", file.c_str(), ev.size(), span);
+    files.push_back({{"file", file}, {"span_s", span}, {"events", ev}});
+  }
+  nlohmann::json per_hour = nlohmann::json::object();
+  for (const auto& [label, n] : by_label) per_hour[label] = seconds > 0 ? static_cast<double>(n) * 3600.0 / seconds : 0.0;
+  if (o.json) {
+    std::printf("%s\n", nlohmann::json{{"model", o.model}, {"seconds", seconds}, {"events_per_hour", per_hour}, {"files", files}}
+                             .dump(2)
+                             .c_str());
+  } else {
+    std::printf("%.1f min of recordings:", seconds / 60.0);
+    if (by_label.empty()) std::printf(" no events");
+    for (const auto& [label, n] : by_label) std::printf(" %s %zu (%.1f per hour)", label.c_str(), n, per_hour[label].get<double>());
+    std::printf("\n");
+  }
+  return bad.exit_code(0, paths.size());
+}
+
 int gesture_spot_model(const GestureOptions& o) {
-  if (!StreamSpotter::is_stream_spotter(o.model))
-    throw UsageError(o.model + ": not a stream spotter (make one with `gesture train --spot ... --out FILE`)");
+  if (!StreamSpotter::is_stream_spotter(o.model)) return gesture_spot_classifier(o);
   const auto spotter = StreamSpotter::load(o.model);
   FeatureOptions f;
   f.set = spotter.feature_set();
@@ -871,9 +922,10 @@ void add_gesture_command(CLI::App& app, GlobalOptions&, Action& run) {
   sp->add_option("--gap", o->gap, "s of the last frame held between clips (default 0: the clips' own idle starts and ends are the rest)")->check(CLI::Range(0.0, 10.0));
   add_spotter_options(sp, *o);
   sp->add_option("--model", o->model,
-                 "a stream spotter from `gesture train --spot`: spot with it in the inputs (no training) and score where "
-                 "they have annotations")
-      ->check(CLI::ExistingFile);
+                 "spot with a trained model in the inputs (no training): a stream spotter from `gesture train --spot` (scored "
+                 "where the inputs have annotations), or a clip classifier (a file, or the built-in 'sim') run through the "
+                 "live component's spotter (events listed and counted per hour)")
+      ->check(CLI::ExistingFile | CLI::IsMember(builtin_model_names()));
   sp->callback([o, &run] { run = [o] { return gesture_spot(*o); }; });
 
   auto* sm = g->add_subcommand("sim", "Simulated pointing sessions (no outside data): train a classifier on some, spot "
