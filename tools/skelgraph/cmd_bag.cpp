@@ -294,22 +294,13 @@ int import_bvh(const MocapOptions& o) {
   std::optional<std::uint64_t> first;
   if (!o.add_to.empty()) {
     const mcap::Reader reader = user_input([&] { return mcap::Reader(o.add_to); });
-    std::map<std::uint16_t, std::uint16_t> channels;
-    for (const auto& m : user_input([&] { return reader.summary(); }).metadata) bag.write_metadata(m.name, m.values);
-    user_input([&] {
-      reader.for_each_message([&](const mcap::Channel& ch, const mcap::Schema* schema, const mcap::Message& m) {
-        if (ch.topic == runtime::topics::kSkeletonTruth.name) return;  // replaced by the mocap
-        auto& mapped = channels[ch.id];
-        if (mapped == 0) {
-          const auto sid = schema ? bag.mcap().add_schema(schema->name, schema->encoding, schema->data) : std::uint16_t{0};
-          mapped = bag.mcap().add_channel(sid, ch.topic, ch.message_encoding, ch.metadata);
-        }
-        mcap::Message copy = m;
-        copy.channel_id = mapped;
-        bag.mcap().write(copy);
-        ++copied;
-        if (!first || m.log_time < *first) first = m.log_time;
-      });
+    copied = user_input([&] {
+      return mcap::copy_messages(
+          reader, bag.mcap(),
+          [](const mcap::Channel& ch) { return ch.topic != runtime::topics::kSkeletonTruth.name; },  // replaced by the mocap
+          [&](const mcap::Channel&, const mcap::Schema*, const mcap::Message& m) {
+            if (!first || m.log_time < *first) first = m.log_time;
+          });
     });
   }
   b.time_offset_s = o.time_offset ? *o.time_offset : first ? 1e-9 * static_cast<double>(*first) : 0.0;

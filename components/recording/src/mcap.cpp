@@ -851,4 +851,25 @@ RecoveryReport recover(const std::string& in_path, const std::string& out_path, 
   return rep;
 }
 
+std::uint64_t copy_messages(const Reader& in, Writer& out, const std::function<bool(const Channel&)>& keep,
+                            const Reader::MessageCallback& after) {
+  for (const auto& m : in.summary().metadata) out.write_metadata(m);
+  std::map<std::uint16_t, std::uint16_t> channels;  // input channel -> output channel
+  std::uint64_t copied = 0;
+  in.for_each_message([&](const Channel& ch, const Schema* schema, const Message& m) {
+    if (keep && !keep(ch)) return;
+    auto& mapped = channels[ch.id];
+    if (mapped == 0) {
+      const auto sid = schema ? out.add_schema(schema->name, schema->encoding, schema->data) : std::uint16_t{0};
+      mapped = out.add_channel(sid, ch.topic, ch.message_encoding, ch.metadata);
+    }
+    Message copy = m;
+    copy.channel_id = mapped;
+    out.write(copy);
+    ++copied;
+    if (after) after(ch, schema, m);
+  });
+  return copied;
+}
+
 }  // namespace skelgraph::mcap

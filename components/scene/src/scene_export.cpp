@@ -112,23 +112,14 @@ ExportReport export_scene(const std::string& in_path, const std::string& out_pat
   if (writer.profile.empty()) writer.profile = summary.profile;
   mcap::Writer out(out_path, std::move(writer));
   SceneTap tap(options);
-  std::uint64_t copied = 0;
-  std::map<std::uint16_t, std::uint16_t> channel_map;  // input channel -> output channel
-  for (const auto& m : summary.metadata) out.write_metadata(m);
-  reader.for_each_message([&](const mcap::Channel& ch, const mcap::Schema* schema, const mcap::Message& m) {
-    if (ch.topic == kSceneTopic || ch.topic == kTransformTopic) return;  // a scene recorded live: made again
-    auto& mapped = channel_map[ch.id];
-    if (mapped == 0) {
-      const auto sid = schema ? out.add_schema(schema->name, schema->encoding, schema->data) : std::uint16_t{0};
-      mapped = out.add_channel(sid, ch.topic, ch.message_encoding, ch.metadata);
-    }
-    mcap::Message copy = m;
-    copy.channel_id = mapped;
-    out.write(copy);
-    ++copied;
-    if (progress && copied % 5000 == 0) progress(copied, summary.message_count);
-    if (schema && ch.message_encoding == "cdr") tap.add(out, ch.topic, schema->name, m.data, static_cast<std::int64_t>(m.log_time));
-  });
+  std::uint64_t seen = 0;
+  const auto copied = mcap::copy_messages(
+      reader, out,
+      [](const mcap::Channel& ch) { return ch.topic != kSceneTopic && ch.topic != kTransformTopic; },  // a live scene: made again
+      [&](const mcap::Channel& ch, const mcap::Schema* schema, const mcap::Message& m) {
+        if (progress && ++seen % 5000 == 0) progress(seen, summary.message_count);
+        if (schema && ch.message_encoding == "cdr") tap.add(out, ch.topic, schema->name, m.data, static_cast<std::int64_t>(m.log_time));
+      });
   tap.finish(out);
   if (progress) progress(copied, summary.message_count);
   out.close();

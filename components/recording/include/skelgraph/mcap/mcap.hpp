@@ -180,4 +180,11 @@ struct RecoveryReport {
 };
 RecoveryReport recover(const std::string& in_path, const std::string& out_path, WriterOptions options = {});
 
+// Copies a file's metadata and messages into `out` as they are (schemas and
+// channels added once each), leaving out the channels `keep` refuses;
+// `after` sees each copied message (with the input's channel and schema).
+// Returns how many messages were copied.
+std::uint64_t copy_messages(const Reader& in, Writer& out, const std::function<bool(const Channel&)>& keep,
+                            const Reader::MessageCallback& after = {});
+
 }  // namespace skelgraph::mcap
