@@ -514,6 +514,11 @@ TEST(StreamSpotting, FindsEachGestureNearItsActionPoint) {
     EXPECT_EQ(before[i].label, after[i].label);
     EXPECT_EQ(before[i].end_ns, after[i].end_ns);
   }
+  // Recognised by its format whatever comes before it (keys are written sorted: "classes" first).
+  std::ofstream(::testing::TempDir() + "/long_classes.json")
+      << R"({"classes": [")" << std::string(500, 'x') << R"("], "format": "skelgraph-stream-spotter"})";
+  EXPECT_TRUE(StreamSpotter::is_stream_spotter(::testing::TempDir() + "/long_classes.json"));
+  EXPECT_FALSE(StreamSpotter::is_stream_spotter(::testing::TempDir() + "/nothing_here.json"));
   std::ofstream(::testing::TempDir() + "/not_spotter.json") << R"({"format": "skelgraph-stream-spotter", "version": 1})";
   EXPECT_THROW(StreamSpotter::load(::testing::TempDir() + "/not_spotter.json"), ModelError);
   // The same windows through the HMM classifier run end to end too.

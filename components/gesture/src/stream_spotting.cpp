@@ -284,10 +284,12 @@ void StreamSpotter::save(const std::string& path) const {
 }
 
 bool StreamSpotter::is_stream_spotter(const std::string& path) {
-  std::ifstream f(path);
-  std::string head(200, '\0');
-  f.read(head.data(), static_cast<std::streamsize>(head.size()));
-  return head.find("\"skelgraph-stream-spotter\"") != std::string::npos;
+  try {
+    const auto j = read_model_json(path);
+    return j.is_object() && j.value("format", "") == "skelgraph-stream-spotter";
+  } catch (const ModelError&) {
+    return false;  // not a readable JSON file: whoever loads it says why
+  }
 }
 
 StreamSpotter StreamSpotter::load(const std::string& path) {
