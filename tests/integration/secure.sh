@@ -4,8 +4,10 @@
 # read-only host), the cell working end to end; strangers shut out: no
 # credentials, or a certificate of another CA, can neither read skeletons nor
 # start a recording; the read-only host reads fused skeletons but cannot
-# publish sync commands; on the wire (tshark) no topic name, type name or
-# other plaintext of our data.
+# publish sync commands; the robot (host `arm`) obeys a stop from the
+# robot-control host only: neither a stranger nor the read-only host can make
+# it stop; on the wire (tshark) no topic name, type name or other plaintext
+# of our data.
 #
 #   secure.sh SKELGRAPH LOSSY_LINK
 source "$(dirname "$0")/lib.sh"
@@ -17,8 +19,9 @@ if ! netns_available; then
   exit 77
 fi
 cell_up "$LOSSY"
-"$SKELGRAPH" security init "$WORK/creds" --master fusion --sensors sensor1,sensor2 --readers robot --json >"$WORK/init.json"
-json_check "$WORK/init.json" 'd["hosts"]["robot"]["role"] == "reader" and "*" in d["hosts"]["fusion"]["publishes"]'
+"$SKELGRAPH" security init "$WORK/creds" --master fusion --sensors sensor1,sensor2 --readers reader1 \
+  --robots arm --robot-control fusion --json >"$WORK/init.json"
+json_check "$WORK/init.json" 'd["hosts"]["reader1"]["role"] == "reader" and "*" in d["hosts"]["fusion"]["publishes"] and d["hosts"]["fusion"]["roles"] == ["master", "robot-control"] and d["hosts"]["fusion"]["denied"] == ["skelgraph/robot/state"] and d["hosts"]["arm"]["publishes"][0] == "skelgraph/robot/state"'
 "$SKELGRAPH" security check "$WORK/creds" --json >"$WORK/check.json" || fail "security check: $(cat "$WORK/check.json")"
 "$SKELGRAPH" security init "$WORK/other" --master fusion --sensors sensor1,sensor2 >/dev/null  # another cell's CA
 CELL_DDS_ARGS=(--security "$WORK/creds")
@@ -33,6 +36,10 @@ for h in fusion sensor1 sensor2; do
   eval "p_$h=\$SPAWNED"
   sleep 1
 done
+# The robot: a host of its own (identity `arm`) in sensor1's namespace.
+printf 'components:\n  - {name: robot, type: robot, params: {robot_id: robot1}}\n' >"$WORK/arm.yaml"
+SKELGRAPH_HOST=arm spawn_sg sensor1 "$WORK/arm.json" "$WORK/arm.err" launch "$WORK/arm.yaml" --duration 120 --json
+p_arm=$SPAWNED
 cell_started=$SECONDS
 
 # A new secure participant (each command-line tool run is one) sometimes does not
@@ -78,14 +85,28 @@ stranger nocreds --profile lan --interface "$(addr sensor2)"
 stranger otherca --profile secure --security "$WORK/other" --interface "$(addr sensor2)"
 grep -q "no sample on skelgraph/skeleton/fused" "$WORK/nocreds.read" || fail "nocreds: $(cat "$WORK/nocreds.read")"
 # The read-only host: reads, but may not publish sync commands.
-SKELGRAPH_HOST=robot retry 3 on sensor2 "$SKELGRAPH" topic echo skelgraph/skeleton/fused --count 5 --json --timeout 10 \
-  $(sg_args sensor2) >"$WORK/robot.read" 2>"$WORK/robot.err" || fail "the read-only host could not read: $(cat "$WORK/robot.err")"
-if SKELGRAPH_HOST=robot on sensor2 "$SKELGRAPH" launch "$SRC/bringup/sync.yaml" --duration 3 $(sg_args sensor2) \
-  >"$WORK/robot.sync" 2>&1; then
-  fail "the read-only host ran a sync master: $(tail -3 "$WORK/robot.sync")"
+SKELGRAPH_HOST=reader1 retry 3 on sensor2 "$SKELGRAPH" topic echo skelgraph/skeleton/fused --count 5 --json --timeout 10 \
+  $(sg_args sensor2) >"$WORK/reader.read" 2>"$WORK/reader.err" || fail "the read-only host could not read: $(cat "$WORK/reader.err")"
+if SKELGRAPH_HOST=reader1 on sensor2 "$SKELGRAPH" launch "$SRC/bringup/sync.yaml" --duration 3 $(sg_args sensor2) \
+  >"$WORK/reader.sync" 2>&1; then
+  fail "the read-only host ran a sync master: $(tail -3 "$WORK/reader.sync")"
 fi
-grep -q "could not create a writer on skelgraph/sync (security: the permissions do not let host 'robot' publish it" \
-  "$WORK/robot.sync" || fail "robot's refusal: $(tail -3 "$WORK/robot.sync")"
+grep -q "could not create a writer on skelgraph/sync (security: the permissions do not let host 'reader1' publish it" \
+  "$WORK/reader.sync" || fail "reader1's refusal: $(tail -3 "$WORK/reader.sync")"
+# The robot's commands: a stranger finds no robot to talk to, the read-only host may not
+# write a command, the robot-control host stops it.
+if on sensor2 "$SKELGRAPH" robot stop --timeout 5 --profile lan --interface "$(addr sensor2)" >"$WORK/stranger.robot" 2>&1; then
+  fail "a stranger's robot stop was taken: $(cat "$WORK/stranger.robot")"
+fi
+grep -q "no state of a robot" "$WORK/stranger.robot" || fail "stranger: $(tail -2 "$WORK/stranger.robot")"
+if SKELGRAPH_HOST=reader1 sg sensor2 robot stop --timeout 5 >"$WORK/reader.robot" 2>&1; then
+  fail "the read-only host's robot stop went out: $(cat "$WORK/reader.robot")"
+fi
+grep -q "could not create a writer on skelgraph/robot/command (security: the permissions do not let host 'reader1'" \
+  "$WORK/reader.robot" || fail "reader1's robot stop: $(tail -2 "$WORK/reader.robot")"
+retry 3 sg fusion robot stop --timeout 10 --json >"$WORK/control.robot" || fail "the robot-control host's stop was not taken"
+json_check "$WORK/control.robot" 'd["taken"] and d["source"] == "operator"'
+ok "robot: a stranger and the read-only host cannot stop it; the robot-control host can"
 retry 3 sg fusion sync stop --timeout 10 --json >"$WORK/stop.json" || fail "sync stop"
 sleep 1
 # Every recorder recorded the master's session only: no session of the strangers'.
@@ -130,6 +151,10 @@ print(len(re.findall(rb"(?<!<topic>)skelgraph/", data)) + data.count(b"skelgraph
 [ "$plain" -eq 0 ] || fail "$plain plaintext topic names, type names or skeleton frame ids in the capture"
 ok "tshark: $frames frames, $secure with protected RTPS submessages, no topic/type name or skeleton data in the clear"
 
+kill -INT "$p_arm"
+wait "$p_arm" || fail "the robot did not stop cleanly: $(tail -3 "$WORK/arm.err")"
+# What the robot took: one protective stop, every command from the operator on the robot-control host.
+json_check "$WORK/arm.json" '[c for c in d["components"] if c["name"] == "robot"][0]["details"]["protective_stops"] == 1 and [c for c in d["components"] if c["name"] == "robot"][0]["details"]["refused_source"] == 0 and [c for c in d["components"] if c["name"] == "robot"][0]["details"]["stopped"]'
 for h in fusion sensor1 sensor2; do eval "kill -INT \$p_$h"; done
 for h in fusion sensor1 sensor2; do eval "wait \$p_$h" || fail "$h did not stop cleanly: $(tail -3 "$WORK/$h.err")"; done
 echo "secure: all checks passed"

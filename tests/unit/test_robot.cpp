@@ -10,6 +10,7 @@
 #include "skelgraph/eval/fetch.hpp"
 #include "skelgraph/eval/safety.hpp"
 #include "skelgraph/robot/arm.hpp"
+#include "skelgraph/robot/command_gate.hpp"
 #include "skelgraph/robot/capsule.hpp"
 #include "skelgraph/robot/fetch.hpp"
 #include "skelgraph/robot/follow.hpp"
@@ -372,4 +373,25 @@ TEST(Fetch, SpottedPointingSendsTheArmNearTheTrueSpot) {
   EXPECT_LE(r.fetched, r.spotted);
   EXPECT_EQ(static_cast<int>(r.error_m.size()), r.fetched);
   EXPECT_GT(r.within, r.fetched / 2);
+}
+
+// The robot's own check of a command beside the permissions (issue 39).
+TEST(RobotCommandGate, KnownSourcesAndFreshStampsOnly) {
+  using skelgraph::robot::CommandGate;
+  using skelgraph::robot::check_command;
+  const CommandGate gate{{"separation", "operator"}, 1.0};
+  const std::int64_t now = 1'000'000'000'000;
+  EXPECT_TRUE(check_command(gate, "separation", now - 200'000'000, now).ok);
+  EXPECT_TRUE(check_command(gate, "operator", now + 500'000'000, now).ok);  // a sender's clock a little ahead
+  const auto stranger = check_command(gate, "mallory", now, now);
+  EXPECT_FALSE(stranger.ok);
+  EXPECT_FALSE(stranger.stale);
+  EXPECT_NE(stranger.reason.find("'mallory'"), std::string::npos);
+  const auto old = check_command(gate, "separation", now - 1'500'000'000, now);
+  EXPECT_FALSE(old.ok);
+  EXPECT_TRUE(old.stale);
+  EXPECT_NE(old.reason.find("1.500 s ago"), std::string::npos) << old.reason;
+  EXPECT_FALSE(check_command(gate, "separation", now + 2'000'000'000, now).ok);  // from the future
+  EXPECT_FALSE(check_command(gate, "separation", 0, now).ok);                    // no stamp
+  EXPECT_TRUE(check_command(CommandGate{{}, 1.0}, "anyone", now, now).ok);       // no list: any source
 }

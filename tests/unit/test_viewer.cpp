@@ -1,9 +1,16 @@
-// The viewer's core: what a frame holds, which frames a slow client gets, and
-// which client requests are accepted.
+// The viewer's core: what a frame holds, which frames a slow client gets,
+// which client requests are accepted, and who may connect (access.hpp).
 #include <gtest/gtest.h>
 
 #include <cmath>
 
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+
+#include "skelgraph/viewer/access.hpp"
 #include "skelgraph/viewer/client_command.hpp"
 #include "skelgraph/viewer/outbox.hpp"
 #include "skelgraph/viewer/scene.hpp"
@@ -270,4 +277,66 @@ TEST(ViewerScene, RobotsAreDrawnWithTheirCapsulesAndSafetyState) {
   EXPECT_EQ(f["robots"][0]["safety"]["body_part"], "right_hand");
   // Not heard of for longer than status_max_age_ns: not drawn.
   EXPECT_TRUE(scene.frame(6'000'000'000).at("robots").empty());
+}
+
+// Who may connect: addresses, tokens, where a request carries its token.
+TEST(ViewerAccess, LoopbackAddresses) {
+  EXPECT_TRUE(is_loopback_address("127.0.0.1"));
+  EXPECT_TRUE(is_loopback_address("127.3.2.1"));
+  EXPECT_TRUE(is_loopback_address("::1"));
+  EXPECT_FALSE(is_loopback_address("0.0.0.0"));
+  EXPECT_FALSE(is_loopback_address("192.0.2.10"));
+  EXPECT_FALSE(is_loopback_address("::"));
+  EXPECT_THROW(is_loopback_address("localhost"), std::runtime_error);
+}
+
+TEST(ViewerAccess, TokensByHashWithExpiry) {
+  EXPECT_EQ(sha256_hex("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");  // FIPS 180-2
+  const auto t = new_token();
+  EXPECT_EQ(t.size(), 64u);
+  EXPECT_NE(t, new_token());
+  const std::vector<TokenEntry> tokens{{sha256_hex(t), 1000, "bob"}, {sha256_hex("old"), 500, "dave"}};
+  EXPECT_TRUE(check_token(tokens, t, 999).ok);
+  EXPECT_EQ(check_token(tokens, t, 999).who, "bob");
+  const auto late = check_token(tokens, t, 1000);
+  EXPECT_FALSE(late.ok);
+  EXPECT_NE(late.reason.find("expired"), std::string::npos);
+  EXPECT_TRUE(check_token(tokens, "old", 400).ok);
+  EXPECT_EQ(check_token(tokens, "nope", 0).reason, "unknown token");
+  EXPECT_EQ(check_token(tokens, "", 0).reason, "no credentials");
+}
+
+TEST(ViewerAccess, TokenOfRequest) {
+  EXPECT_EQ(token_of_request("Bearer abc", "skelgraph_token=def", "/?token=ghi").token, "abc");
+  EXPECT_EQ(token_of_request("", "a=1; skelgraph_token=def; b=2", "/?token=ghi").token, "def");
+  const auto q = token_of_request("", "a=1", "/index.html?x=1&token=ghi");
+  EXPECT_EQ(q.token, "ghi");
+  EXPECT_TRUE(q.from_query);
+  EXPECT_EQ(token_of_request("Basic xyz", "", "/").token, "");
+  EXPECT_EQ(target_without_token("/?token=ghi"), "/");
+  EXPECT_EQ(target_without_token("/a?x=1&token=ghi&y=2"), "/a?x=1&y=2");
+  EXPECT_EQ(target_without_token("/a"), "/a");
+}
+
+TEST(ViewerAccess, TokensFileReadAgainWhenItChanges) {
+  const auto dir = std::filesystem::temp_directory_path() / ("skelgraph_tokens_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto file = (dir / "tokens").string();
+  TokenStore store(file);
+  EXPECT_FALSE(store.check("t1", 0).ok);  // no file: nobody
+  { std::ofstream(file) << "# comment\n" << token_line({sha256_hex("t1"), 2000, "bob"}) << "\n"; }
+  EXPECT_TRUE(store.check("t1", 0).ok);
+  // Each change with its own modification time (not left to the file system's clock granularity).
+  const auto t0 = std::filesystem::last_write_time(file);
+  { std::ofstream(file) << token_line({sha256_hex("t2"), 2000, "carol"}) << "\n"; }
+  std::filesystem::last_write_time(file, t0 + std::chrono::seconds(1));
+  EXPECT_FALSE(store.check("t1", 0).ok);
+  EXPECT_TRUE(store.check("t2", 0).ok);
+  { std::ofstream(file) << "not a token line\n"; }
+  std::filesystem::last_write_time(file, t0 + std::chrono::seconds(2));
+  const auto bad = store.check("t2", 0);
+  EXPECT_FALSE(bad.ok);
+  EXPECT_NE(bad.reason.find(file + ":1"), std::string::npos) << bad.reason;
+  EXPECT_THROW(read_tokens(file), std::runtime_error);
+  std::filesystem::remove_all(dir);
 }

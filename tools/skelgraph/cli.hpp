@@ -107,6 +107,7 @@ void add_run_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_play_data_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_topic_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_sync_command(CLI::App& app, GlobalOptions& g, Action& run);
+void add_robot_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_player_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_security_command(CLI::App& app, GlobalOptions& g, Action& run);
 void add_demo_command(CLI::App& app, GlobalOptions& g, Action& run);

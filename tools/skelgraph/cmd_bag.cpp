@@ -647,6 +647,7 @@ void add_bag_command(CLI::App& app, GlobalOptions& g, Action& run) {
 
   struct ViewOpts {
     std::string address = "127.0.0.1";
+    std::string credentials;
     int port = 8080;
     double rate = 1.0;
     bool paused = false, loop = false;
@@ -655,7 +656,11 @@ void add_bag_command(CLI::App& app, GlobalOptions& g, Action& run) {
   auto* view = app.add_subcommand(
       "view", "A recording in the browser: plays it (bag_player, held at the end) with the viewer; the page has a timeline (seek, speed, pause, step)");
   view->add_option("file", o->file, "MCAP file")->required()->check(CLI::ExistingFile);
-  view->add_option("--address", v->address, "where the page is served (0.0.0.0: every interface)");
+  view->add_option("--address", v->address,
+                   "where the page is served (0.0.0.0: every interface; anything but loopback needs --credentials)");
+  view->add_option("--credentials", v->credentials,
+                   "the cell's credentials (skelgraph security init, viewer): HTTPS, and a viewer certificate or token "
+                   "for every request");
   view->add_option("--port", v->port, "TCP port of the page (0: any free port)")->check(CLI::Range(0, 65535));
   view->add_option("--rate", v->rate, "speed at start: 1 = as recorded")->check(kPositive);
   view->add_flag("--paused", v->paused, "start paused");
@@ -672,7 +677,10 @@ void add_bag_command(CLI::App& app, GlobalOptions& g, Action& run) {
             {"paused", b(v->paused), "view"},
             {"loop", b(v->loop), "view"},
             {"hold_at_end", "true", "view"}}},
-          {"viewer", "viewer", {{"address", v->address, "view"}, {"port", std::to_string(v->port), "view"}}}};
+          {"viewer", "viewer",
+           {{"address", v->address, "view"},
+            {"port", std::to_string(v->port), "view"},
+            {"credentials", v->credentials, "view"}}}};
       return user_input([&] { return run_components(g, list, r->run); });
     };
   });

@@ -166,6 +166,7 @@ int main(int argc, char** argv) {
   add_play_data_command(app, g, run);
   add_topic_command(app, g, run);
   add_sync_command(app, g, run);
+  add_robot_command(app, g, run);
   add_player_command(app, g, run);
   add_security_command(app, g, run);
   add_demo_command(app, g, run);

@@ -107,7 +107,12 @@ runtime::ComponentInfo RobotComponent::describe() {
       .add_string("start_joints_deg", "0,-90,90,-90,-90,0", "joint angles at start, degrees")
       .add_double("rate_hz", 100.0, "control and state rate", 1.0, 1000.0)
       .add_string_list("task", {}, "a task of its own: the tool round these points 'x,y,z' (world, m), until a command takes over")
-      .add_double("task_speed", 0.5, "the task's tool speed, m/s (times the speed scale)", 0.01, 1.0);
+      .add_double("task_speed", 0.5, "the task's tool speed, m/s (times the speed scale)", 0.01, 1.0)
+      .add_string_list("accept_from", {"separation", "follow", "fetch", "operator"},
+                       "sources whose commands it takes (the commanding component's name; `skelgraph robot` sends "
+                       "as 'operator'); others are refused and counted")
+      .add_double("max_command_age_s", 1.0,
+                  "a command stamped longer ago than this (or this far ahead: a clock off) is refused", 0.01, 60.0);
   return info;
 }
 
@@ -118,6 +123,7 @@ RobotComponent::RobotComponent(runtime::Context& ctx, const runtime::Params& par
            parse_joints_deg(params.get<std::string>("start_joints_deg"))),
       rate_hz_(params.get<double>("rate_hz")),
       task_speed_(params.get<double>("task_speed")),
+      gate_{params.get<std::vector<std::string>>("accept_from"), params.get<double>("max_command_age_s")},
       state_pub_(ctx, runtime::topics::kRobotState),
       command_sub_(ctx, runtime::topics::kRobotCommand,
                    [this](const msg::RobotCommand& c, const runtime::SampleMeta&) { on_command(c); }) {
@@ -143,6 +149,13 @@ void RobotComponent::on_start() {
 void RobotComponent::on_command(const msg::RobotCommand& c) {
   if (c.robot_id().size() > 0 && c.robot_id().to_string() != id_) {
     ++ignored_;
+    return;
+  }
+  const auto verdict = check_command(gate_, c.source().to_string(), c.stamp_ns(), ctx_.clock().now_ns());
+  if (!verdict.ok) {
+    ++(verdict.stale ? refused_stale_ : refused_source_);
+    if (last_refusal_ != verdict.reason) spdlog::warn("{}: refused {}", ctx_.name(), verdict.reason);
+    last_refusal_ = verdict.reason;
     return;
   }
   ++commands_;
@@ -181,14 +194,25 @@ void RobotComponent::step() {
   }
   arm_.step(dt);
   ++steps_;
-  if (state_pub_.publish(state_msg(id_, arm_, ctx_.clock().now_ns()))) ++published_;
-  ctx_.set_health(runtime::HealthState::Ok, arm_.stopped() ? "protective stop" : "running");
+  const bool sent = state_pub_.publish(state_msg(id_, arm_, ctx_.clock().now_ns()));
+  ++(sent ? published_ : failed_publish_);
+  std::string message = arm_.stopped() ? "protective stop" : "running";
+  if (refused_source_ + refused_stale_ > 0)
+    message += "; refused " + std::to_string(refused_source_) + " command(s) from unknown sources, " +
+               std::to_string(refused_stale_) + " stale (last: " + last_refusal_ + ")";
+  if (!sent) {
+    ctx_.set_health(runtime::HealthState::Degraded, "its state could not be written; " + message);
+  } else {
+    ctx_.set_health(runtime::HealthState::Ok, message);
+  }
 }
 
 std::string RobotComponent::summary() const {
   std::ostringstream os;
   os << id_ << " (" << arm_.model().name << "): " << published_ << " states, " << commands_ << " commands, " << stops_
      << " protective stop(s)";
+  if (refused_source_ + refused_stale_ > 0)
+    os << ", refused " << refused_source_ << " command(s) from unknown sources and " << refused_stale_ << " stale";
   return os.str();
 }
 
@@ -196,6 +220,8 @@ nlohmann::json RobotComponent::details() const {
   const auto t = arm_.tool_world();
   return {{"robot_id", id_},   {"model", arm_.model().name}, {"steps", steps_},         {"published", published_},
           {"commands", commands_}, {"ignored", ignored_},     {"protective_stops", stops_},
+          {"refused_source", refused_source_}, {"refused_stale", refused_stale_}, {"last_refusal", last_refusal_},
+          {"failed_publish", failed_publish_},
           {"stopped", arm_.stopped()}, {"speed_scale", arm_.speed_scale()}, {"tool", {t.x(), t.y(), t.z()}},
           {"task_points_reached", task_points_reached_}};
 }

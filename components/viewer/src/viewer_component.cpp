@@ -5,6 +5,7 @@
 #include "skelgraph/msg/json.hpp"
 #include "skelgraph/runtime/topics.hpp"
 #include "skelgraph/skeleton/skeleton_msg.hpp"
+#include "skelgraph/viewer/access.hpp"
 #include "skelgraph/viewer/client_command.hpp"
 
 #ifndef SKELGRAPH_VIEWER_WEB_DIR
@@ -15,7 +16,8 @@ namespace skelgraph::viewer {
 
 runtime::ComponentInfo ViewerComponent::describe() {
   runtime::ComponentInfo info{"viewer", "Live 3-D view of the cell in a web browser (HTTP + WebSocket)", {}};
-  info.params.add_string("address", "127.0.0.1", "address to serve the page on (0.0.0.0: every interface)")
+  info.params.add_string("address", "127.0.0.1",
+                         "address to serve the page on (0.0.0.0: every interface; anything but loopback needs credentials)")
       .add_int("port", 8080, "TCP port (0: any free port, printed at start)", 0, 65535)
       .add_double("rate_hz", 30.0, "frames sent to each page per second", 1.0, 120.0)
       .add_int("max_clients", 64, "pages connected at once; more are refused (HTTP 503)", 1, 4096)
@@ -23,7 +25,14 @@ runtime::ComponentInfo ViewerComponent::describe() {
       .add_double("fov_h_deg", 57.0, "sensors' horizontal field of view (drawn frustums)", 1.0, 179.0)
       .add_double("fov_v_deg", 43.0, "sensors' vertical field of view", 1.0, 179.0)
       .add_double("far_m", 4.0, "depth of the drawn frustums", 0.1, 50.0)
-      .add_string("web_root", "", "folder with the page (default: the one the build made)");
+      .add_string("web_root", "", "folder with the page (default: the one the build made)")
+      .add_string("credentials", "",
+                  "the cell's credentials directory (skelgraph security init): HTTPS/WSS, and a viewer certificate or "
+                  "token for every request (default: the DDS security directory, if any)")
+      .add_string("secure", "auto",
+                  "auto: HTTPS with credentials on any address but loopback (refused without credentials); "
+                  "on: also on loopback",
+                  {"auto", "on"});
   return info;
 }
 
@@ -80,6 +89,22 @@ ViewerComponent::ViewerComponent(runtime::Context& ctx, const runtime::Params& p
   o.port = static_cast<std::uint16_t>(params.get<std::int64_t>("port"));
   o.max_clients = static_cast<std::size_t>(params.get<std::int64_t>("max_clients"));
   o.assets = load_assets(root);
+  // Anything but loopback: HTTPS/WSS with a certificate or token, or not at all.
+  const bool secure = params.get<std::string>("secure") == "on" || !is_loopback_address(address_);
+  if (secure) {
+    std::string dir = params.get<std::string>("credentials");
+    if (dir.empty()) dir = ctx.config().security_dir;
+    if (dir.empty())
+      throw std::runtime_error(
+          "viewer: serving on " + address_ +
+          " needs the cell's credentials (anyone who can reach the port would see every worker): make them with "
+          "`skelgraph security init DIR ...` and `skelgraph security viewer DIR --server " + ctx.config().host +
+          " --address ADDRESS`, then set the viewer's credentials: DIR (or run the secure profile with --security "
+          "DIR); or serve on 127.0.0.1");
+    const auto c = find_viewer_credentials(dir, ctx.config().host);
+    o.tls = Server::Options::Tls{c.cert_file, c.key_file, c.ca_file, c.tokens_file};
+  }
+  secure_ = o.tls.has_value();
   server_ = std::make_unique<Server>(std::move(o), [this](const std::string& text, bool& bad) {
     return on_client_message(text, bad);
   });
@@ -88,7 +113,7 @@ ViewerComponent::ViewerComponent(runtime::Context& ctx, const runtime::Params& p
 ViewerComponent::~ViewerComponent() { on_shutdown(); }
 
 std::string ViewerComponent::url() const {
-  return "http://" + address_ + ":" + std::to_string(server_->port()) + "/";
+  return std::string(secure_ ? "https://" : "http://") + address_ + ":" + std::to_string(server_->port()) + "/";
 }
 
 void ViewerComponent::on_start() {
@@ -99,7 +124,15 @@ void ViewerComponent::on_start() {
     frame["viewer"] = ctx_.name();
     frame["made_ns"] = t;  // CLOCK_MONOTONIC of this host: delays measured by clients on it
     server_->broadcast(std::make_shared<const std::string>(frame.dump()));
-    ++frames_made_;
+    const auto made = ++frames_made_;
+    // A secure viewer says on its status, once a second, who came in and how many were refused.
+    if (secure_ && made % 30 == 1) {
+      const auto s = server_->stats();
+      ctx_.set_health(runtime::HealthState::Ok,
+                      "https: let in " + std::to_string(s.by_certificate) + " by certificate, " +
+                          std::to_string(s.by_token) + " by token; refused " + std::to_string(s.tls_refused) +
+                          " at TLS, " + std::to_string(s.auth_refused) + " without credentials");
+    }
   });
 }
 
@@ -139,7 +172,11 @@ std::string ViewerComponent::summary() const {
   return url() + ": " + std::to_string(s.connections) + " page(s) connected (peak " + std::to_string(s.peak_clients) +
          " at once), " + std::to_string(frames_made_.load()) + " frames made, " + std::to_string(s.frames_dropped) +
          " dropped for slow pages, " + std::to_string(s.bad_messages) + " bad client messages, " +
-         std::to_string(s.refused) + " refused";
+         std::to_string(s.refused) + " refused" +
+         (secure_ ? ", " + std::to_string(s.by_certificate) + " requests by certificate and " + std::to_string(s.by_token) +
+                        " by token, " + std::to_string(s.tls_refused + s.auth_refused) + " refused access" +
+                        (s.last_refusal.empty() ? "" : " (last: " + s.last_refusal + ")")
+                  : "");
 }
 
 nlohmann::json ViewerComponent::details() const {
@@ -155,6 +192,13 @@ nlohmann::json ViewerComponent::details() const {
           {"frames_dropped", s.frames_dropped},
           {"bad_messages", s.bad_messages},
           {"http_requests", s.http_requests},
+          {"secure", secure_},
+          {"tls_refused", s.tls_refused},
+          {"tls_abandoned", s.tls_abandoned},
+          {"auth_refused", s.auth_refused},
+          {"by_certificate", s.by_certificate},
+          {"by_token", s.by_token},
+          {"last_refusal", s.last_refusal},
           {"play_requests", play_requests_.load()}};
 }
 

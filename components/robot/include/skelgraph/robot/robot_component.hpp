@@ -2,14 +2,16 @@
 // `robot` component: the simulated arm (ArmSim) in the cell. Publishes its
 // state on skelgraph/robot/state at `rate_hz` (joints, tool, speed scale,
 // stop, capsules in the world) and obeys skelgraph/robot/command (move the
-// tool to a target, hold, speed scale, protective stop, resume). Its state is
-// its truth: recorded like the people's.
+// tool to a target, hold, speed scale, protective stop, resume) when it comes
+// from a source it takes and is fresh (CommandGate; refusals on its status).
+// Its state is its truth: recorded like the people's.
 
 #include <cstdint>
 #include <string>
 #include <vector>
 
 #include "skelgraph/robot/arm.hpp"
+#include "skelgraph/robot/command_gate.hpp"
 #include "skelgraph/runtime/component.hpp"
 #include "skelgraph/runtime/pubsub.hpp"
 
@@ -38,7 +40,10 @@ class RobotComponent final : public runtime::Component {
   double rate_hz_;
   double task_speed_ = 0.5;
   std::int64_t last_mono_ns_ = 0;
-  std::uint64_t steps_ = 0, commands_ = 0, stops_ = 0, ignored_ = 0, published_ = 0;
+  std::uint64_t steps_ = 0, commands_ = 0, stops_ = 0, ignored_ = 0, published_ = 0, failed_publish_ = 0;
+  CommandGate gate_;
+  std::uint64_t refused_source_ = 0, refused_stale_ = 0;
+  std::string last_refusal_;
   runtime::Publisher<msg::RobotState> state_pub_;
   runtime::Subscription<msg::RobotCommand> command_sub_;
   runtime::TimerHandle timer_;

@@ -12,6 +12,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 
 namespace skelgraph::viewer {
@@ -20,6 +21,8 @@ struct Asset {
   std::string body;
   std::string content_type;
 };
+
+// (See access.hpp for who may connect when the viewer is secure.)
 
 // Every regular file under `dir`, keyed by its path from there ("index.html",
 // "three/three.module.js"). Throws std::runtime_error naming the folder when it
@@ -35,6 +38,12 @@ struct ServerStats {
   std::uint64_t frames_dropped = 0;  // not sent because a newer frame came first (slow clients)
   std::uint64_t bad_messages = 0;  // malformed client messages answered with an error
   std::uint64_t http_requests = 0;
+  // Secure viewers only (Options::tls):
+  std::uint64_t tls_refused = 0;   // TLS handshakes that failed: no TLS at all, a certificate of another CA, expired
+  std::uint64_t tls_abandoned = 0; // connections the client closed before its handshake (browsers' spare ones)
+  std::uint64_t auth_refused = 0;  // requests without a valid certificate or token (HTTP 401)
+  std::uint64_t by_certificate = 0, by_token = 0;  // requests let in, by how
+  std::string last_refusal;        // why the last one was refused, and from where
 };
 
 class Server {
@@ -44,6 +53,12 @@ class Server {
     std::uint16_t port = 8080;  // 0: any free port (see port())
     std::size_t max_clients = 64;
     std::map<std::string, Asset> assets;
+    // Set: HTTPS/WSS only, and every request must bring a client certificate
+    // (signed by ca_file, OU=viewer) or a token from tokens_file (access.hpp).
+    struct Tls {
+      std::string cert_file, key_file, ca_file, tokens_file;
+    };
+    std::optional<Tls> tls;
   };
   // Called on the server's thread for each text message from a client; returns
   // the reply to send to that client ("" for none). `bad` is set when the

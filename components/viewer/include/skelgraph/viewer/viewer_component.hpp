@@ -37,6 +37,7 @@ class ViewerComponent final : public runtime::Component {
 
   Scene scene_;
   std::string address_;
+  bool secure_ = false;  // HTTPS/WSS with credentials
   std::int64_t period_ns_;
   std::unique_ptr<Server> server_;
   std::atomic<std::uint64_t> frames_made_{0}, play_requests_{0};
