@@ -40,30 +40,30 @@ ViewerCredentials find_viewer_credentials(const std::string& dir, const std::str
   return c;
 }
 
+namespace {
+std::string to_hex(const unsigned char* bytes, std::size_t n) {
+  static const char* hex = "0123456789abcdef";
+  std::string out;
+  for (std::size_t i = 0; i < n; ++i) {
+    out += hex[bytes[i] >> 4];
+    out += hex[bytes[i] & 15];
+  }
+  return out;
+}
+}  // namespace
+
 std::string sha256_hex(const std::string& text) {
   unsigned char md[EVP_MAX_MD_SIZE];
   unsigned int n = 0;
   if (EVP_Digest(text.data(), text.size(), md, &n, EVP_sha256(), nullptr) != 1)
     throw std::runtime_error("viewer: SHA-256 failed (OpenSSL)");
-  static const char* hex = "0123456789abcdef";
-  std::string out;
-  for (unsigned int i = 0; i < n; ++i) {
-    out += hex[md[i] >> 4];
-    out += hex[md[i] & 15];
-  }
-  return out;
+  return to_hex(md, n);
 }
 
 std::string new_token() {
   unsigned char b[32];
   if (RAND_bytes(b, sizeof(b)) != 1) throw std::runtime_error("security: no random bytes (OpenSSL RAND_bytes)");
-  static const char* hex = "0123456789abcdef";
-  std::string out;
-  for (unsigned char c : b) {
-    out += hex[c >> 4];
-    out += hex[c & 15];
-  }
-  return out;
+  return to_hex(b, sizeof(b));
 }
 
 std::string token_line(const TokenEntry& e) {
