@@ -3,7 +3,7 @@
 # simulated arm working beside a walking worker with speed-and-separation monitoring;
 # the verdicts are published and obeyed (the robot is slowed and stopped, and
 # resumes). Fail-safes: with no people data, and with no robot state, the
-# verdict is a protective stop saying why.
+# verdict is a protective stop saying why. A stop gesture stops it too.
 #   robot.sh SKELGRAPH PUBLISH_GESTURE
 source "$(dirname "$0")/lib.sh"
 PUBLISH_GESTURE=${2:?publish_gesture}
@@ -151,4 +151,29 @@ YAML
 "$SKELGRAPH" launch "$WORK/no_robot.yaml" --duration 3 --json >"$WORK/no_robot.json" 2>/dev/null || fail "no_robot launch"
 json_check "$WORK/no_robot.json" '[c for c in d["components"] if c["name"] == "separation"][0]["details"]["steps_by_state"] == {"PROTECTIVE_STOP": [c for c in d["components"] if c["name"] == "separation"][0]["details"]["steps"]} and "robot state" in [c for c in d["components"] if c["name"] == "separation"][0]["details"]["reason"]'
 ok "no robot state: protective stop throughout"
+
+# A stop gesture stops the robot, though nobody is near it (the arm stands 8 m from the walking
+# worker), for gesture_stop_s; then it runs again.
+cat >"$WORK/gesture_stop.yaml" <<'YAML'
+components:
+  - {name: sim, type: sim, params: {scenario: walk, sensor_count: 2, loop: true}}
+  - {name: fusion, type: fusion, params: {method: kalman, trigger: arrival}}
+  - {name: robot, type: robot, params: {base: "8,0,8,180"}}
+  - {name: separation, type: separation, params: {gesture_stop_s: 1.0}}
+YAML
+"$SKELGRAPH" launch "$WORK/gesture_stop.yaml" --duration 10 --json >"$WORK/gesture_stop.json" 2>"$WORK/gesture_stop.err" &
+gs=$!
+wait_for_match "$WORK/gesture_stop.err" "\[start\] separation" 20 || fail "gesture_stop graph did not start"
+# Until the monitor has settled in RUN (the worker far away).
+run_state() {
+  "$SKELGRAPH" topic echo skelgraph/safety --json --count 1 --timeout 5 >"$WORK/gs_state.json" 2>/dev/null &&
+    python3 -c 'import json, sys; sys.exit(0 if json.load(open(sys.argv[1]))["data"]["state"] == "RUN" else 1)' "$WORK/gs_state.json"
+}
+for _ in $(seq 20); do run_state && break; done
+run_state || fail "the monitor never ran with the worker 8 m away: $(cat "$WORK/gs_state.json")"
+"$PUBLISH_GESTURE" 1 stop 2>/dev/null
+wait "$gs" || fail "gesture_stop launch: $(tail -3 "$WORK/gesture_stop.err")"
+grep -q "protective stop: stop gesture by person 7" "$WORK/gesture_stop.err" || fail "no stop for the gesture: $(grep separation "$WORK/gesture_stop.err" | tail -3)"
+json_check "$WORK/gesture_stop.json" '[c for c in d["components"] if c["name"] == "separation"][0]["details"]["stop_gestures"] >= 1 and [c for c in d["components"] if c["name"] == "robot"][0]["details"]["protective_stops"] >= 1 and [c for c in d["components"] if c["name"] == "separation"][0]["details"]["state"] == "RUN"'
+ok "a stop gesture stops the robot with nobody near, and it runs again after gesture_stop_s"
 echo "robot: all checks passed"

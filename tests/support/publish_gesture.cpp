@@ -1,8 +1,8 @@
 // publish_gesture: a pointing GestureEvent with a ray and a floor target,
 // twice a second for N seconds, on skelgraph/gesture/event (for the viewer's
 // browser test: the page must draw the ray and the target and name them).
-//   publish_gesture [SECONDS]        (default 10)
-// Every event: label "pointing", person 7, right arm, ray from (0, 1.4, 0)
+//   publish_gesture [SECONDS] [LABEL]   (default 10, "pointing")
+// Every event: label LABEL, person 7, right arm, ray from (0, 1.4, 0)
 // towards (1, -1, 0)/sqrt(2), target (1.4, 0, 0) named "floor".
 #include <chrono>
 #include <cmath>
@@ -21,7 +21,7 @@ int main(int argc, char** argv) {
   runtime::Context ctx("publish_gesture", config);
   runtime::Publisher<msg::GestureEvent> pub(ctx, runtime::topics::kGestureEvent);
   msg::GestureEvent e;
-  e.label("pointing");
+  e.label(argc > 2 ? argv[2] : "pointing");
   e.person_id(7);
   e.source("skelgraph/skeleton/fused");
   e.arm("right");

@@ -271,6 +271,36 @@ TEST(Spotting, AConfirmationDropsPointingHeldBriefly) {
   EXPECT_TRUE(long_hold[0].has_ray);
 }
 
+// A held gesture other than pointing (a raised palm: "stop") goes out once
+// held `hold` s, without a ray, not when the arm comes down.
+TEST(Spotting, AHeldStopGoesOutWhileTheArmIsStillUp) {
+  std::vector<Clip> clips;
+  for (int i = 0; i < 4; ++i) {
+    Clip c;
+    c.label = 0;
+    c.x = Sequence::Random(30, 8);
+    clips.push_back(c);
+  }
+  ClassMap map;
+  map.classes = {"stop"};
+  Classifier c = one_state(clips, map);
+  c.set_threshold(-1e300);
+  // The arm up at 90 degrees from 2.0 to 2.5 s, held until 5.5 s, down by 6 s.
+  const auto held = [](double t) {
+    return 90.0 * (std::clamp((t - 2.0) / 0.5, 0.0, 1.0) - std::clamp((t - 5.5) / 0.5, 0.0, 1.0));
+  };
+  const auto early = spot(c, arm_stream(held, 9), any_ray());
+  ASSERT_EQ(early.size(), 1u);
+  EXPECT_EQ(early[0].label, "stop");
+  EXPECT_FALSE(early[0].has_ray);
+  EXPECT_LT(early[0].end_ns * 1e-9, 3.5);  // still held (until 5.5 s)
+  SpotterOptions late = any_ray();
+  late.held_labels.clear();
+  const auto at_end = spot(c, arm_stream(held, 9), late);
+  ASSERT_EQ(at_end.size(), 1u);
+  EXPECT_GT(at_end[0].end_ns * 1e-9, 6.0);  // once the arm is down and rested
+}
+
 TEST(Spotting, AHangingArmIsNoPointing) {
   const auto c = always_point();
   // Pointing at the floor ahead (70 degrees up from hanging): one event, its ray that way.

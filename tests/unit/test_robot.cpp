@@ -174,17 +174,22 @@ TEST(Separation, DecidesRunReducedOrStopAndFailsSafe) {
   // Nobody there: run.
   in.separation_m = std::numeric_limits<double>::infinity();
   EXPECT_EQ(decide(p, stop, in).state, SafetyState::Run);
-  // Fail-safe: stale people data, stale robot state, a lost sensor, a person fusion cannot place.
-  for (int k = 0; k < 4; ++k) {
+  // Fail-safe: stale people data, stale robot state, a lost sensor, a person fusion cannot place;
+  // and a person's stop gesture.
+  for (int k = 0; k < 5; ++k) {
     SeparationInput bad = in;
     bad.separation_m = 10.0;  // far away: only the fail-safe stops it
     if (k == 0) bad.people_age_s = 0.3;
     if (k == 1) bad.robot_age_s = 0.2;
     if (k == 2) bad.coverage_lost = true;
     if (k == 3) bad.unplaced_person = true;
+    if (k == 4) bad.stop_gesture = "stop gesture by person 2";
     const auto s2 = decide(p, stop, bad);
     EXPECT_EQ(s2.state, SafetyState::ProtectiveStop) << k;
     EXPECT_FALSE(s2.reason.empty());
+    if (k == 4) {
+      EXPECT_EQ(s2.reason, "stop gesture by person 2");
+    }
   }
   SeparationInput fresh = in;
   fresh.separation_m = 10.0;

@@ -75,7 +75,7 @@ struct GestureOptions {
 ClassMap class_map(const std::string& c) {
   const auto& presets = ClassMap::preset_names();
   if (std::find(presets.begin(), presets.end(), c) != presets.end()) return ClassMap::preset(c);
-  if (!std::filesystem::exists(c)) throw UsageError("--classes: '" + c + "' is neither a preset (two-class, five-class) nor a file");
+  if (!std::filesystem::exists(c)) throw UsageError("--classes: '" + c + "' is neither a preset (two-class, five-class, robot) nor a file");
   return ClassMap::load(c);
 }
 
@@ -797,7 +797,7 @@ void add_common(CLI::App* c, GestureOptions& o, bool model_options) {
       ->check(CLI::IsMember({"stop", "skip"}));
   if (!model_options) return;
   c->add_flag("--no-trim", o.no_trim, "keep each clip whole (default: only the part where the arms move)");
-  c->add_option("--classes", o.classes, "two-class (point vs garbage; default), five-class, or a class-mapping YAML file");
+  c->add_option("--classes", o.classes, "two-class (point vs garbage; default), five-class, robot (point, stop, come_here, wave, other), or a class-mapping YAML file");
   add_model_options(c, o);
 }
 

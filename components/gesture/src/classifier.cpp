@@ -168,7 +168,7 @@ const char* hands_name(Hands h) {
 // --- Class maps ---
 
 const std::vector<std::string>& ClassMap::preset_names() {
-  static const std::vector<std::string> names{"two-class", "five-class"};
+  static const std::vector<std::string> names{"two-class", "five-class", "robot"};
   return names;
 }
 
@@ -185,8 +185,17 @@ ClassMap ClassMap::preset(const std::string& name) {
                       {"Walk-in-place", "walk"},
                       {"Raise-your-hand", "overhead"},
                       {"Wave-your-hand", "wave"}};
+  } else if (name == "robot") {
+    // A robot cell's commands: point (fetch), stop (a raised palm), come here, wave; the rest rejected.
+    m.classes = {"point", "stop", "come_here", "wave", "other"};
+    m.action_class = {{"Point-at-the-camera", "point"},
+                      {"Signal-someone-to-stop", "stop"},
+                      {"Signal-someone-to-come-here", "come_here"},
+                      {"Wave-your-hand", "wave"},
+                      {"Wave-your-other-hand", "wave"}};
+    m.garbage = "other";
   } else {
-    throw ModelError("unknown class preset '" + name + "' (expected two-class, five-class or a YAML file)");
+    throw ModelError("unknown class preset '" + name + "' (expected two-class, five-class, robot or a YAML file)");
   }
   return m;
 }

@@ -49,6 +49,8 @@ runtime::ComponentInfo GestureComponent::describe() {
   info.params.add_string("model", "", "classifier file (skelgraph gesture train / gesture sim --out), or 'sim': the built-in pointing model (trained on simulated sessions by the build)")
       .add_string("input", "fused", "skeleton stream to watch", {"fused", "raw", "truth"})
       .add_string("point_label", "point", "the classifier's label for pointing")
+      .add_string_list("held_labels", {"stop"}, "other gestures made by holding an arm out: reported once held hold_s, "
+                                                "not when the arm comes down")
       .add_string_list("surfaces", {"floor:0,0,0"},
                        "where pointing rays may land: 'name:x,y,z' (horizontal plane through the point) or "
                        "'name:x,y,z:nx,ny,nz'; the nearest hit wins")
@@ -71,6 +73,7 @@ namespace {
 SpotterOptions spotter_options(const runtime::Params& params) {
   SpotterOptions o;
   o.point_label = params.get<std::string>("point_label");
+  o.held_labels = params.get<std::vector<std::string>>("held_labels");
   o.hold = params.get<double>("hold_s");
   o.aim = params.get<double>("aim_s");
   o.still_speed = params.get<double>("still_speed");

@@ -232,7 +232,7 @@ std::vector<SpottedEvent> Spotter::step(const skeleton::Skeleton& s, const Wrist
     for (int side = 0; side < 2; ++side) {
       if (hold_since_[side] < 0 || static_cast<double>(t - hold_since_[side]) * 1e-9 < o_.hold) continue;
       if (auto e = decide(t, true)) {
-        if (o_.aim > o_.hold || o_.confirm > 0) {  // decided; the ray is gathered until the arm moves or `aim` has passed
+        if (e->label == o_.point_label && (o_.aim > o_.hold || o_.confirm > 0)) {  // decided; the ray is gathered until the arm moves or `aim` has passed
           aiming_side_ = e->arm == kSideName[1] ? 1 : 0;
           aiming_hold_ns_ = hold_since_[aiming_side_];
           aiming_ = std::move(e);
@@ -326,7 +326,8 @@ std::optional<SpottedEvent> Spotter::decide(std::int64_t now_ns, bool early) {
   if (!std::isfinite(d.scores[static_cast<std::size_t>(d.label)])) return std::nullopt;
   if (d.label == c_.garbage_index() || (d.rejected && c_.garbage_index() < 0)) return std::nullopt;
   const bool point = label == o_.point_label;
-  if (early && !point) return std::nullopt;
+  const bool held = std::find(o_.held_labels.begin(), o_.held_labels.end(), label) != o_.held_labels.end();
+  if (early && !point && !held) return std::nullopt;
   SpottedEvent e;
   e.label = label;
   e.person_id = person_;

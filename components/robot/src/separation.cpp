@@ -107,6 +107,7 @@ SafetyDecision decide(const SeparationParams& p, const StoppingModel& stop, cons
   }
   if (in.coverage_lost) return stop_because("a sensor covering the robot's surroundings is lost and no other covers it");
   if (in.unplaced_person) return stop_because("a person fusion cannot place");
+  if (!in.stop_gesture.empty()) return stop_because(in.stop_gesture);
   if (!std::isfinite(in.separation_m)) {
     d.state = SafetyState::Run;
     d.speed_scale = 1.0;

@@ -43,7 +43,11 @@ runtime::ComponentInfo SeparationComponent::describe() {
       .add_double("sensor_timeout_ms", 500.0, "a sensor without a frame this long is lost", 10.0, 10000.0)
       .add_double("release_ms", 500.0, "after a stop, the way must be clear this long before the robot moves again",
                   0.0, 10000.0)
-      .add_int("min_sensors", 1, "fewer live sensors than this: protective stop (coverage lost)", 0, 64);
+      .add_int("min_sensors", 1, "fewer live sensors than this: protective stop (coverage lost)", 0, 64)
+      .add_string("stop_label", "stop",
+                  "a gesture event with this label (skelgraph/gesture/event) stops the robot (\"\": gestures never do)")
+      .add_double("gesture_stop_s", 5.0, "a stop gesture holds the robot this long (then release_ms as after any stop)",
+                  0.1, 600.0);
   return info;
 }
 
@@ -59,6 +63,8 @@ SeparationComponent::SeparationComponent(runtime::Context& ctx, const runtime::P
       latch_(params.get<double>("release_ms") * 1e-3),
       safety_pub_(ctx, runtime::topics::kSafety),
       command_pub_(ctx, runtime::topics::kRobotCommand),
+      stop_label_(params.get<std::string>("stop_label")),
+      gesture_stop_s_(params.get<double>("gesture_stop_s")),
       fused_sub_(
           ctx, runtime::topics::kSkeletonFused,
           [this](const msg::Skeleton& m, const runtime::SampleMeta& meta) {
@@ -75,7 +81,16 @@ SeparationComponent::SeparationComponent(runtime::Context& ctx, const runtime::P
       frame_sub_(ctx, runtime::topics::kSensorFrame,
                  [this](const msg::SensorFrame& f, const runtime::SampleMeta& meta) {
                    sensor_seen_ns_[f.sensor_id().to_string()] = meta.receive_ns;
-                 }) {
+                 }),
+      gesture_sub_(ctx, runtime::topics::kGestureEvent,
+                   [this](const msg::GestureEvent& e, const runtime::SampleMeta&) {
+                     if (stop_label_.empty() || e.label().to_string() != stop_label_) return;
+                     ++stop_gestures_;
+                     gesture_stop_until_ns_ = ctx_.clock().now_ns() + static_cast<std::int64_t>(gesture_stop_s_ * 1e9);
+                     gesture_stop_reason_ = "stop gesture by person " + std::to_string(e.person_id()) + " (" +
+                                            e.source().to_string() + ")";
+                     spdlog::warn("{}: {}", ctx_.name(), gesture_stop_reason_);
+                   }) {
   params_.margin_m = params.get<double>("margin_m");
   params_.max_people_age_s = params.get<double>("max_people_age_ms") * 1e-3;
   params_.max_robot_age_s = params.get<double>("max_robot_age_ms") * 1e-3;
@@ -149,6 +164,7 @@ void SeparationComponent::step() {
   }
   in.people_age_s = people_age;
   in.reaction_s = people_age + last_compute_s_ + command_latency_s_;
+  if (now < gesture_stop_until_ns_) in.stop_gesture = gesture_stop_reason_;
   const auto d = latch_.apply(decide(params_, stopping_, in), static_cast<double>(now) * 1e-9);
   last_compute_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (std::isfinite(in.reaction_s)) reaction_ms_.add(in.reaction_s * 1e3);
@@ -204,6 +220,7 @@ std::string SeparationComponent::summary() const {
 nlohmann::json SeparationComponent::details() const {
   return {{"robot_id", robot_id_},     {"steps", steps_},           {"steps_by_state", time_in_},
           {"protective_stops", stops_}, {"commands", commands_},     {"failed_writes", failed_writes_},
+          {"stop_gestures", stop_gestures_},
           {"state", safety_state_name(last_.state)}, {"reason", last_.reason},
           {"reaction_ms", reaction_ms_.json()}};
 }

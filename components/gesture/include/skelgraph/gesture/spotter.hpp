@@ -21,7 +21,8 @@
 // arm moves again or `aim` s after the hold began, whichever is first, with
 // the shoulder -> hand ray averaged over the hold (the trackers' errors
 // wander over about a second, so a longer look halves the target error of a
-// quarter-second one). Any other segment is classified when it
+// quarter-second one). A held class (`held_labels`: "stop") that wins then
+// goes out at once, without a ray. Any other segment is classified when it
 // closes; an event goes out when its class is not garbage (or, for a
 // classifier without a garbage class, not below the rejection threshold),
 // and for pointing only when an extended arm was held in the segment.
@@ -81,6 +82,9 @@ struct SpotterOptions {
   double min_confidence = 0.0; // events less sure than this are dropped (the operating point: recall against false alarms)
   double confirm = 0.0;        // s: pointing must stay held this long after `hold` or it is dropped (a confirmation; 0: none)
   std::string point_label = "point";
+  // Other gestures made by holding an arm out (a raised palm: "stop"): fired
+  // early too, once held `hold` s, without a ray; the rest when their segment closes.
+  std::vector<std::string> held_labels{"stop"};
   std::vector<Surface> surfaces{Surface{}};  // the ray's target: the nearest hit
 };
 

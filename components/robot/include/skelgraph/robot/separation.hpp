@@ -74,6 +74,7 @@ struct SeparationInput {
   double robot_age_s = 0;          // how old the robot state is (+inf: none yet)
   bool coverage_lost = false;      // a sensor covering the robot's surroundings is lost and none other covers it
   bool unplaced_person = false;    // fusion reports a person it cannot place
+  std::string stop_gesture;        // a person asked for a stop by gesture: who and when ("" none)
 };
 
 struct SafetyDecision {

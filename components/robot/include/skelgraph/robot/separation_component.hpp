@@ -56,9 +56,15 @@ class SeparationComponent final : public runtime::Component {
   runtime::Percentiles reaction_ms_;
   runtime::Publisher<msg::SafetyStatus> safety_pub_;
   runtime::Publisher<msg::RobotCommand> command_pub_;
+  std::string stop_label_;      // before the subscriptions: their callbacks read them
+  double gesture_stop_s_ = 5.0;
+  std::int64_t gesture_stop_until_ns_ = 0;  // a stop gesture holds the robot until then
+  std::string gesture_stop_reason_;
+  std::uint64_t stop_gestures_ = 0;
   runtime::Subscription<msg::Skeleton> fused_sub_;
   runtime::Subscription<msg::RobotState> robot_sub_;
   runtime::Subscription<msg::SensorFrame> frame_sub_;
+  runtime::Subscription<msg::GestureEvent> gesture_sub_;
   runtime::TimerHandle timer_;
 };
 
