@@ -2,6 +2,7 @@
 // into an MCAP file and comes back out exactly (import/export round trip).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <map>
@@ -12,6 +13,7 @@
 #include "skelgraph/msg/cdr.hpp"
 #include "skelgraph/playback/readers.hpp"
 #include "skelgraph/recording/bag.hpp"
+#include "skelgraph/recording/merge.hpp"
 #include "skelgraph/recording/session_recorder.hpp"
 #include "skelgraph/recording/tick_frames.hpp"
 #include "skelgraph/skeleton/skeleton_msg.hpp"
@@ -158,5 +160,92 @@ TEST(SessionRecorder, ARestartedRecorderNeverOverwritesItsSessionFile) {
   EXPECT_EQ(fs::file_size(first), size);  // untouched
   recording::SessionRecorder c(o, "cell", 42, 5'000);
   EXPECT_EQ(fs::path(c.path()).filename(), "cell_42_sensor1_3.mcap");
+  fs::remove_all(dir);
+}
+
+// bag merge as a library: two hosts' recordings onto the master's clock, the
+// sample both recorded kept once, a host's repeats kept, ticks associated,
+// a file that is not a host's recording refused.
+TEST(Merge, TwoHostsOntoTheMastersClockInOrder) {
+  const auto dir = fs::temp_directory_path() / ("skelgraph_merge_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const auto skel = [](const std::string& sensor, std::uint64_t frame, std::int64_t stamp) {
+    msg::Skeleton s;
+    s.sensor_id(sensor);
+    s.person_id(1);
+    s.frame_number(frame);
+    s.stamp_ns(stamp);
+    return s;
+  };
+  const std::uint64_t s0 = 1'000'000'000'000;
+  {
+    // Host "master": ticks every 100 ms; sensorA's frames; one sample host "b" recorded as well.
+    recording::BagWriter a((dir / "a.mcap").string());
+    a.write_metadata("session", {{"host", "master"}});
+    for (int k = 0; k < 10; ++k) {
+      msg::SyncCommand tick;
+      tick.kind(msg::SYNC_TICK);
+      tick.session_id(7);
+      tick.tick(static_cast<std::uint64_t>(k));
+      tick.master_stamp_ns(static_cast<std::int64_t>(s0) + k * 100'000'000);
+      a.write("skelgraph/sync", tick, s0 + k * 100'000'000ULL + 1'000, 0);
+      a.write("skelgraph/skeleton/raw", skel("sensorA", static_cast<std::uint64_t>(k), 0), s0 + k * 100'000'000ULL + 50'000'000, 0);
+    }
+    a.write("skelgraph/skeleton/raw", skel("shared", 1, 42), s0 + 500'000'000, 0);
+    a.close();
+    // Host "b": its clock 2 s ahead of the master's (its estimate recorded by the master's clock topic);
+    // sensorB's frames, the shared sample (seen 1 ms later), and a repeat of its own.
+    recording::BagWriter b((dir / "b.mcap").string());
+    b.write_metadata("session", {{"host", "b"}});
+    msg::ClockOffset c;
+    c.host("b");
+    c.offset_ns(2'000'000'000);
+    c.stamp_ns(static_cast<std::int64_t>(s0));
+    b.write("skelgraph/sync/clock", c, s0 + 2'000'000'000ULL, 0);
+    for (int k = 0; k < 10; ++k)
+      b.write("skelgraph/skeleton/raw", skel("sensorB", static_cast<std::uint64_t>(k), 0), s0 + 2'000'000'000ULL + k * 100'000'000ULL + 60'000'000, 0);
+    b.write("skelgraph/skeleton/raw", skel("shared", 1, 42), s0 + 2'000'000'000ULL + 501'000'000, 0);
+    b.write("skelgraph/skeleton/raw", skel("sensorB", 9, 0), s0 + 2'000'000'000ULL + 960'000'000, 0);  // a repeat of its own
+    b.close();
+    recording::BagWriter none((dir / "none.mcap").string());
+    none.write("skelgraph/skeleton/raw", skel("x", 1, 0), s0, 0);
+    none.close();
+  }
+  recording::MergeOptions o;
+  o.queue_bytes = 64;  // the reader threads hand over a message or two at a time
+  const auto r = recording::merge_recordings({(dir / "a.mcap").string(), (dir / "b.mcap").string()},
+                                             (dir / "out.mcap").string(), o);
+  EXPECT_EQ(r.duplicates_dropped, 1u);
+  EXPECT_EQ(r.tick_records, 10u);
+  ASSERT_EQ(r.inputs.size(), 2u);
+  EXPECT_TRUE(r.inputs[1].estimated);
+  EXPECT_EQ(r.inputs[1].offset_ns, 2e9);
+  EXPECT_EQ(r.out_of_order, 0u);
+  // Out: every message on the master's clock, in order; sensorB 10 ms after sensorA each tick.
+  std::vector<std::pair<std::uint64_t, std::string>> out;
+  std::uint64_t shared = 0, b9 = 0;
+  mcap::Reader(( dir / "out.mcap").string()).for_each_message([&](const mcap::Channel& ch, const mcap::Schema*, const mcap::Message& m) {
+    std::string what = ch.topic;
+    if (ch.topic == "skelgraph/skeleton/raw") {
+      const auto s = msg::from_cdr<msg::Skeleton>(m.data.data(), m.data.size());
+      what += " " + s.sensor_id().to_string();
+      if (s.sensor_id().to_string() == "shared") ++shared;
+      if (s.sensor_id().to_string() == "sensorB" && s.frame_number() == 9) ++b9;
+    }
+    out.emplace_back(m.log_time, what);
+  });
+  EXPECT_EQ(out.size(), r.messages);
+  EXPECT_TRUE(std::is_sorted(out.begin(), out.end(), [](const auto& x, const auto& y) { return x.first < y.first; }));
+  EXPECT_EQ(shared, 1u);
+  EXPECT_EQ(b9, 2u);  // a host's own repeat is kept
+  const auto b0 = std::find(out.begin(), out.end(), std::make_pair(s0 + 60'000'000, std::string("skelgraph/skeleton/raw sensorB")));
+  EXPECT_NE(b0, out.end()) << "sensorB's first frame not at its corrected time";
+  // A file without a host's session metadata: refused, naming it.
+  try {
+    recording::merge_recordings({(dir / "a.mcap").string(), (dir / "none.mcap").string()}, (dir / "bad.mcap").string());
+    ADD_FAILURE() << "merged a file without a host";
+  } catch (const recording::MergeError& e) {
+    EXPECT_NE(std::string(e.what()).find("none.mcap"), std::string::npos) << e.what();
+  }
   fs::remove_all(dir);
 }

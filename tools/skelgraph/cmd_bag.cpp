@@ -26,6 +26,7 @@
 #include "skelgraph/playback/bvh.hpp"
 #include "skelgraph/playback/readers.hpp"
 #include "skelgraph/recording/bag.hpp"
+#include "skelgraph/recording/merge.hpp"
 #include "skelgraph/recording/session_recorder.hpp"
 #include "skelgraph/recording/tick_frames.hpp"
 #include "skelgraph/runtime/topics.hpp"
@@ -48,25 +49,6 @@ auto user_input(F&& f) {
   }
 }
 
-// Ticks acked per host: distinct ticks of the recording's sessions (the
-// sessions its sync topic names). An ack of the previous session's last tick
-// can arrive after the next session's file was opened; it is not counted.
-class AckTally {
- public:
-  void ack(const msg::SyncAck& a) { acks_.insert({a.host().to_string(), a.session_id(), a.tick()}); }
-  void session(std::uint32_t id) { sessions_.insert(id); }
-  std::map<std::string, std::uint64_t> by_host() const {
-    std::map<std::string, std::uint64_t> out;
-    for (const auto& [host, session, tick] : acks_) {
-      if (sessions_.count(session)) ++out[host];
-    }
-    return out;
-  }
-
- private:
-  std::set<std::tuple<std::string, std::uint32_t, std::uint64_t>> acks_;
-  std::set<std::uint32_t> sessions_;
-};
 
 // What one recording holds (the `bag info --json` object).
 nlohmann::json info_of(const std::string& file) {
@@ -82,7 +64,7 @@ nlohmann::json info_of(const std::string& file) {
   std::uint64_t ticks = 0;
   std::set<std::uint32_t> sessions;
   std::map<std::string, std::uint64_t> per_sensor, ticks_with;
-  AckTally acks;
+  recording::AckTally acks;
   std::uint64_t tick_records = 0, older_skeletons = 0;
   std::map<std::string, nlohmann::json> clocks;
   reader.for_each_message([&](const mcap::Channel& ch, const mcap::Schema* schema, const mcap::Message& m) {
@@ -439,139 +421,37 @@ int recover(const std::string& in, const std::string& out, bool json) {
   return 0;
 }
 
-// Several hosts' recordings of one session onto the sync master's timeline:
-// each file's log times are corrected by its host's clock offset (the latest
-// skelgraph/sync/clock estimate found in any input, drift included); a message
-// recorded by several hosts (same topic, same bytes) is kept once; repeats
-// within one recording are kept. Every sync tick gets a TickFrames record on
-// skelgraph/sync/tick_frames: the frame of each stream current at that tick.
+// Several hosts' recordings of one session onto the sync master's timeline
+// (recording/merge.hpp: streaming, in bounded memory).
 int merge(const std::vector<std::string>& files, const std::string& out_path, mcap::Compression compression,
           double max_age_ms, bool json) {
-  struct Input {
-    std::string file, host;
-  };
-  std::vector<Input> inputs;
-  std::map<std::string, msg::ClockOffset> clocks;  // latest per host
-  std::vector<std::unique_ptr<mcap::Reader>> readers;
-  for (const auto& f : files) {
-    readers.push_back(user_input([&] { return std::make_unique<mcap::Reader>(f); }));
-    const auto s = user_input([&] { return readers.back()->summary(); });
-    std::string host;
-    for (const auto& m : s.metadata) {
-      if (m.name == "session" && m.values.count("host")) host = m.values.at("host");
+  recording::MergeOptions options;
+  options.compression = compression;
+  options.max_age_ms = max_age_ms;
+  const auto r = user_input([&] {
+    try {
+      return recording::merge_recordings(files, out_path, options);
+    } catch (const recording::MergeError& e) {
+      throw UsageError(e.what());
     }
-    if (host.empty()) throw UsageError(f + ": no session metadata naming its host (not written by the recorder?)");
-    inputs.push_back({f, host});
-    readers.back()->for_each_message([&](const mcap::Channel& ch, const mcap::Schema*, const mcap::Message& m) {
-      if (ch.topic != runtime::topics::kSyncClock.name) return;
-      auto c = msg::from_cdr<msg::ClockOffset>(m.data.data(), m.data.size());
-      auto& slot = clocks[c.host().to_string()];
-      if (c.stamp_ns() >= slot.stamp_ns()) slot = c;
-    });
-  }
-  struct Item {
-    std::uint64_t time;
-    std::string topic, type;
-    bool keyed;
-    std::string data;
-    std::uint64_t publish_time;
-    std::size_t input;
-  };
-  std::vector<Item> items;
-  std::map<std::pair<std::string, std::string>, std::size_t> seen;  // (topic, bytes) -> the input that had it
-  std::uint64_t duplicates = 0;
-  nlohmann::json applied = nlohmann::json::object();
-  AckTally acks;
-  for (std::size_t i = 0; i < inputs.size(); ++i) {
-    const auto it = clocks.find(inputs[i].host);
-    const double offset = it == clocks.end() ? 0.0 : static_cast<double>(it->second.offset_ns());
-    const double drift = it == clocks.end() ? 0.0 : it->second.drift_ppm() * 1e-6;
-    const double at = it == clocks.end() ? 0.0 : static_cast<double>(it->second.stamp_ns());
-    applied[inputs[i].file] = {{"host", inputs[i].host}, {"offset_ns", offset}, {"drift_ppm", drift * 1e6},
-                               {"estimated", it != clocks.end()}};
-    readers[i]->for_each_message([&](const mcap::Channel& ch, const mcap::Schema* schema, const mcap::Message& m) {
-      const auto type = ch.metadata.count("dds_type") ? ch.metadata.at("dds_type") : std::string();
-      // Older schemas are written in the current one (the merged file's schema is the current IDL).
-      const auto upgraded = msg::may_be_older_schema(type, schema ? schema->data : std::string())
-                                ? msg::upgrade_cdr(type, m.data.data(), m.data.size())
-                                : std::nullopt;
-      const std::string data = upgraded ? std::string(upgraded->begin(), upgraded->end()) : std::string(m.data);
-      const auto [where, fresh] = seen.emplace(std::make_pair(ch.topic, data), i);
-      if (!fresh && where->second != i) {  // another host recorded the same sample
-        ++duplicates;
-        return;
-      }
-      // Host clock -> master clock: subtract the offset the host had at that moment.
-      const double t = static_cast<double>(m.log_time);
-      const double corrected = t - (offset + drift * (t - at));
-      const bool keyed = ch.metadata.count("keyed") && ch.metadata.at("keyed") == "true";
-      if (ch.topic == runtime::topics::kSyncAck.name) {
-        acks.ack(msg::from_cdr<msg::SyncAck>(m.data.data(), m.data.size()));
-      } else if (ch.topic == runtime::topics::kSync.name) {
-        acks.session(msg::from_cdr<msg::SyncCommand>(m.data.data(), m.data.size()).session_id());
-      }
-      items.push_back(
-          {static_cast<std::uint64_t>(std::max(0.0, corrected)), ch.topic, type, keyed, data, m.publish_time, i});
-    });
-  }
-  std::stable_sort(items.begin(), items.end(), [](const Item& a, const Item& b) { return a.time < b.time; });
-  mcap::WriterOptions wo;
-  wo.compression = compression;
-  recording::BagWriter bag(out_path, wo);
-  mcap::KeyValues meta{{"inputs", std::to_string(files.size())}, {"duplicates_dropped", std::to_string(duplicates)}};
-  for (const auto& in : inputs) meta["host " + in.host] = in.file;
-  for (const auto& [host, c] : clocks) {
-    meta["offset_ns " + host] = std::to_string(c.offset_ns());
-    meta["drift_ppm " + host] = std::to_string(c.drift_ppm());
-  }
-  const auto acks_by_host = acks.by_host();
-  for (const auto& [host, n] : acks_by_host) meta["ticks_acked " + host] = std::to_string(n);
-  bag.write_metadata("merge", meta);
-  recording::TickAssociator assoc(static_cast<std::int64_t>(max_age_ms * 1e6));
-  std::uint64_t tick_records = 0, frames_at_ticks = 0;
-  for (const auto& it : items) {
-    bag.write_cdr(it.topic, it.type, it.keyed, it.data, it.time, it.publish_time);
-    const auto* bytes = reinterpret_cast<const std::uint8_t*>(it.data.data());
-    msg::FrameRef f;
-    if (it.type == msg::MessageTraits<msg::Skeleton>::name) {
-      const auto k = msg::from_cdr<msg::Skeleton>(bytes, it.data.size());
-      f.sensor_id(k.sensor_id());
-      f.person_id(k.person_id());
-      f.frame_number(k.frame_number());
-      f.stamp_ns(k.stamp_ns());
-    } else if (it.type == msg::MessageTraits<msg::DepthFrame>::name) {
-      const auto d = msg::from_cdr<msg::DepthFrame>(bytes, it.data.size());
-      f.sensor_id(d.sensor_id());
-      f.frame_number(d.frame_number());
-      f.stamp_ns(d.stamp_ns());
-    } else if (it.topic == runtime::topics::kSync.name) {
-      const auto c = msg::from_cdr<msg::SyncCommand>(bytes, it.data.size());
-      if (c.kind() != msg::SYNC_TICK) continue;
-      const auto tf = assoc.tick(c.session_id(), c.tick(), c.master_stamp_ns(), static_cast<std::int64_t>(it.time));
-      bag.write(recording::kTickFramesTopic, tf, it.time, it.time);
-      ++tick_records;
-      frames_at_ticks += tf.frames().size();
-      continue;
-    } else {
-      continue;
-    }
-    f.topic(it.topic.substr(0, 128));
-    f.host(inputs[it.input].host.substr(0, 64));
-    f.log_time_ns(static_cast<std::int64_t>(it.time));
-    assoc.frame(f);
-  }
-  bag.close();
+  });
+  nlohmann::json inputs = nlohmann::json::object();
+  for (const auto& in : r.inputs)
+    inputs[in.file] = {{"host", in.host}, {"offset_ns", in.offset_ns}, {"drift_ppm", in.drift_ppm}, {"estimated", in.estimated}};
   const nlohmann::json report{{"out", out_path},
-                              {"messages", items.size() + tick_records},
-                              {"duplicates_dropped", duplicates},
-                              {"inputs", applied},
-                              {"ticks_acked_by_host", acks_by_host},
-                              {"tick_records", tick_records},
-                              {"frames_per_tick", tick_records > 0 ? static_cast<double>(frames_at_ticks) / tick_records : 0.0}};
+                              {"messages", r.messages},
+                              {"duplicates_dropped", r.duplicates_dropped},
+                              {"inputs", inputs},
+                              {"ticks_acked_by_host", r.ticks_acked_by_host},
+                              {"tick_records", r.tick_records},
+                              {"frames_per_tick", r.tick_records > 0 ? static_cast<double>(r.frames_at_ticks) / r.tick_records : 0.0},
+                              {"out_of_order", r.out_of_order},
+                              {"peak_held_messages", r.peak_held}};
   if (json) std::printf("%s\n", report.dump(2).c_str());
-  else std::printf("%s: %zu messages (%llu duplicates dropped) from %zu recordings; %llu ticks, %.1f frames each\n",
-                   out_path.c_str(), items.size(), static_cast<unsigned long long>(duplicates), files.size(),
-                   static_cast<unsigned long long>(tick_records), report["frames_per_tick"].get<double>());
+  else std::printf("%s: %llu messages (%llu duplicates dropped) from %zu recordings; %llu ticks, %.1f frames each\n",
+                   out_path.c_str(), static_cast<unsigned long long>(r.messages),
+                   static_cast<unsigned long long>(r.duplicates_dropped), files.size(),
+                   static_cast<unsigned long long>(r.tick_records), report["frames_per_tick"].get<double>());
   return 0;
 }
 

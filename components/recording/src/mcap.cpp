@@ -547,6 +547,7 @@ Reader::Reader(const std::string& path) : name_(path) {
   auto [storage, bytes] = map_file(path);
   storage_ = std::move(storage);
   bytes_ = bytes;
+  mapped_ = storage_ != nullptr;
 }
 
 Reader::Reader(std::string bytes, std::string name) : name_(std::move(name)) {
@@ -658,7 +659,18 @@ void Reader::scan(Scan& s, bool strict) const {
     // Other records inside chunks are ignored, as the specification asks.
   };
   bool data_end = false;
+  // Pages of the mapping behind the scan are given back every 8 MiB (the file's
+  // contents stay in the page cache; touched again, they are mapped again).
+  const auto page = static_cast<std::uint64_t>(::sysconf(_SC_PAGESIZE));
+  std::uint64_t released = 0;
+  const auto release_behind = [&](std::uint64_t upto) {
+    if (!mapped_ || upto < released + (8u << 20)) return;
+    const std::uint64_t end = upto / page * page;
+    ::madvise(const_cast<char*>(all.data()) + released, end - released, MADV_DONTNEED);
+    released = end;
+  };
   while (!file.done()) {
+    release_behind(file.offset());
     In r = next_record(&op, &at);
     if (op == kDataEnd) {
       const auto crc = r.u32("data section crc");

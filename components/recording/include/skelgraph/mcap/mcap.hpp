@@ -142,7 +142,8 @@ struct Summary {
 class Reader {
  public:
   // Maps the file read-only (memory is the page cache, not a copy; one chunk
-  // at a time is decompressed). Throws McapError (not an MCAP file, too
+  // at a time is decompressed; a scan releases the pages behind it, so a
+  // process reading a file of any size holds a few MB of it). Throws McapError (not an MCAP file, too
   // short, unreadable). The file must not shrink while a Reader is open.
   explicit Reader(const std::string& path);
   // From bytes already in memory (`name` for messages).
@@ -166,6 +167,7 @@ class Reader {
 
   std::shared_ptr<const void> storage_;  // the mapping, or the bytes given
   std::string_view bytes_;
+  bool mapped_ = false;  // a scan gives back the pages it has read (the process's memory stays small on GB files)
   std::string name_;
 };
 
