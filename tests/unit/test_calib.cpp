@@ -12,6 +12,7 @@
 
 #include "skelgraph/calib/rigid.hpp"
 #include "skelgraph/calib/skeleton_calib.hpp"
+#include "skelgraph/skeleton/stats.hpp"
 #include "skelgraph/sim/simulation.hpp"
 
 using namespace skelgraph;
@@ -242,8 +243,8 @@ TEST(SkeletonCalib, FindsTheClockOffset) {
 TEST(SkeletonCalib, HeldOutDistancesShrink) {
   const auto p = simulate("walk", 1, 30);
   const auto r = calib::calibrate_from_skeletons(p.ref, p.other);
-  const auto before = calib::median(calib::joint_distances(p.ref, p.other, Eigen::Isometry3d::Identity(), 0, {}, 10.0));
-  const auto after = calib::median(calib::joint_distances(p.ref, p.other, r.fit.transform()));
+  const auto before = stats::upper_median(calib::joint_distances(p.ref, p.other, Eigen::Isometry3d::Identity(), 0, {}, 10.0));
+  const auto after = stats::upper_median(calib::joint_distances(p.ref, p.other, r.fit.transform()));
   EXPECT_GT(before, 0.3);  // the sensors' frames are far apart
   EXPECT_LT(after, 0.08);
 }
@@ -253,7 +254,7 @@ TEST(SkeletonCalib, HeldOutDistancesShrink) {
 // as low as the true pose's on the same data, and lower than its start.
 TEST(SkeletonCalib, TheLowestMedianPoseBeatsItsStartAndTheTruth) {
   const auto p = simulate("walk", 1, 30);
-  const auto at = [&](const Eigen::Isometry3d& x) { return calib::median(calib::joint_distances(p.ref, p.other, x)); };
+  const auto at = [&](const Eigen::Isometry3d& x) { return stats::upper_median(calib::joint_distances(p.ref, p.other, x)); };
   Eigen::Isometry3d off = p.truth;
   off.pretranslate(Vector3d(0.05, 0.0, 0.0));
   off.prerotate(Eigen::AngleAxisd(3.0 * M_PI / 180.0, Vector3d::UnitY()).toRotationMatrix());
@@ -275,7 +276,7 @@ TEST(SkeletonCalib, TheLowestMedianPoseBeatsItsStartAndTheTruth) {
 // one search from the same pose; no starts is a clear error.
 TEST(SkeletonCalib, MoreStartsOfTheLowestMedianSearchNeverEndHigher) {
   const auto p = simulate("walk", 1, 20);
-  const auto at = [&](const Eigen::Isometry3d& x) { return calib::median(calib::joint_distances(p.ref, p.other, x)); };
+  const auto at = [&](const Eigen::Isometry3d& x) { return stats::upper_median(calib::joint_distances(p.ref, p.other, x)); };
   Eigen::Isometry3d off = p.truth;
   off.pretranslate(Vector3d(0.25, -0.1, 0.2));
   off.prerotate(Eigen::AngleAxisd(12.0 * M_PI / 180.0, Vector3d(1, 1, 0).normalized()).toRotationMatrix());

@@ -16,6 +16,8 @@
 
 #include "cli.hpp"
 #include "skelgraph/calib/board.hpp"
+#include "skelgraph/skeleton/json_number.hpp"
+#include "skelgraph/skeleton/stats.hpp"
 #include "skelgraph/calib/calib_file.hpp"
 #include "skelgraph/calib/cell_calib.hpp"
 #include "skelgraph/calib/skeleton_calib.hpp"
@@ -92,7 +94,6 @@ nlohmann::json pose_json(const Eigen::Isometry3d& T) {
 }
 
 double cm(double m) { return std::isfinite(m) ? std::round(m * 1000.0) / 10.0 : m; }
-nlohmann::json num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
 
 // The reference sensor's pose in the world: from a calibration file, or the
 // identity (the reference's frame is the world) without one.
@@ -166,7 +167,7 @@ double cell_median(const std::map<std::string, std::vector<calib::TimedSkeleton>
     const auto d = calib::joint_distances(data.at(s), v, poses.at(s).inverse() * poses.at(t), 0, joints, 2.0);
     all.insert(all.end(), d.begin(), d.end());
   }
-  return calib::median(all);
+  return stats::upper_median(all);
 }
 
 // Every sensor of one input at once (no --other and more than one other sensor).
@@ -215,10 +216,10 @@ nlohmann::json calibrate_cell_input(const std::string& path, const SkelOptions& 
     sj["path"] = s.path;
     sj["reference_from_sensor"] = pose_json(s.reference_from_sensor);
     sj["joint_pairs"] = s.pairs;
-    sj["median_distance_cm"] = num(cm(s.median_m));
-    sj["rms_residual_cm"] = num(cm(s.rms_m));
-    sj["max_residual_cm"] = num(cm(s.max_m));
-    sj["fit_median_distance_cm"] = {{"before", num(cm(fb))}, {"after", num(cm(fa))}};
+    sj["median_distance_cm"] = json_number(cm(s.median_m));
+    sj["rms_residual_cm"] = json_number(cm(s.rms_m));
+    sj["max_residual_cm"] = json_number(cm(s.max_m));
+    sj["fit_median_distance_cm"] = {{"before", json_number(cm(fb))}, {"after", json_number(cm(fa))}};
     sj["improved"] = improved;
     sj["undecided"] = s.ambiguous;
     if (s.ambiguous) ++undecided;
@@ -230,14 +231,14 @@ nlohmann::json calibrate_cell_input(const std::string& path, const SkelOptions& 
   if (o.holdout) {
     for (auto& sj : sensors) {
       const auto id = sj["sensor"].get<std::string>();
-      sj["held_out_median_distance_cm"] = {{"before", num(cm(cell_median(test, id, before, upper)))},
-                                           {"after", num(cm(cell_median(test, id, chosen, upper)))}};
+      sj["held_out_median_distance_cm"] = {{"before", json_number(cm(cell_median(test, id, before, upper)))},
+                                           {"after", json_number(cm(cell_median(test, id, chosen, upper)))}};
     }
   }
   auto& links = j["links"] = nlohmann::json::array();
   for (const auto& l : r.links) {
     nlohmann::json lj{{"a", l.a}, {"b", l.b}, {"solved", l.solved}, {"in_tree", l.in_tree}, {"joint_pairs", l.pairs},
-                      {"mirrored_frames", l.mirrored}, {"median_distance_cm", num(cm(l.median_m))}};
+                      {"mirrored_frames", l.mirrored}, {"median_distance_cm", json_number(cm(l.median_m))}};
     if (l.solved) {
       lj["ambiguous"] = l.fit.ambiguous;
       lj["resolved_by_prior"] = l.fit.resolved_by_prior;
@@ -309,8 +310,8 @@ nlohmann::json calibrate_one(const std::string& path, const SkelOptions& o, std:
     throw UsageError(path + ": cannot calibrate " + other + " against " + o.ref + ": " + e.what());
   }
   // Never worse than before: judged on the data it was fitted to (the held-out half stays unseen).
-  const double fit_before = calib::median(calib::joint_distances(fit_ref, fit_oth, before, 0, {}, 2.0));
-  const double fit_after = calib::median(calib::joint_distances(fit_ref, fit_oth, r.fit.transform(), r.clock_offset_ns, {}, 2.0));
+  const double fit_before = stats::upper_median(calib::joint_distances(fit_ref, fit_oth, before, 0, {}, 2.0));
+  const double fit_after = stats::upper_median(calib::joint_distances(fit_ref, fit_oth, r.fit.transform(), r.clock_offset_ns, {}, 2.0));
   const bool undecided = r.ambiguous && !r.resolved_by_prior;
   const bool improved = !undecided && !(fit_after >= fit_before);
   const Eigen::Isometry3d chosen = improved ? r.fit.transform() : before;
@@ -333,21 +334,21 @@ nlohmann::json calibrate_one(const std::string& path, const SkelOptions& o, std:
                    {"inliers", r.inliers},
                    {"rms_residual_cm", cm(r.fit.rms)},
                    {"max_residual_cm", cm(r.fit.max)},
-                   {"fit_median_distance_cm", {{"before", num(cm(fit_before))}, {"after", num(cm(fit_after))}}}};
+                   {"fit_median_distance_cm", {{"before", json_number(cm(fit_before))}, {"after", json_number(cm(fit_after))}}}};
   nlohmann::json per = nlohmann::json::object();
   for (const auto& jr : r.per_joint) {
-    per[skeleton::joint_name(jr.joint)] = {{"pairs", jr.pairs}, {"median_cm", num(cm(jr.median_m))}, {"rms_cm", num(cm(jr.rms_m))}};
+    per[skeleton::joint_name(jr.joint)] = {{"pairs", jr.pairs}, {"median_cm", json_number(cm(jr.median_m))}, {"rms_cm", json_number(cm(jr.rms_m))}};
   }
   j["per_joint"] = per;
   if (o.holdout) {
     const auto upper = upper_body();
-    const double b = calib::median(calib::joint_distances(test_ref, test_oth, before, 0, upper, 2.0));
-    const double a = calib::median(calib::joint_distances(test_ref, test_oth, chosen, chosen_offset, upper, 2.0));
-    j["held_out_median_distance_cm"] = {{"before", num(cm(b))}, {"after", num(cm(a))}};
+    const double b = stats::upper_median(calib::joint_distances(test_ref, test_oth, before, 0, upper, 2.0));
+    const double a = stats::upper_median(calib::joint_distances(test_ref, test_oth, chosen, chosen_offset, upper, 2.0));
+    j["held_out_median_distance_cm"] = {{"before", json_number(cm(b))}, {"after", json_number(cm(a))}};
     if (o.best_rigid) {
       // The floor: the best rigid pose found near the chosen one for the held-out half itself.
       const auto floor = calib::lowest_median_pose(test_ref, test_oth, chosen, chosen_offset, upper, 2.0, o.best_rigid_starts);
-      j["held_out_best_rigid_median_cm"] = num(cm(floor.median_m));
+      j["held_out_best_rigid_median_cm"] = json_number(cm(floor.median_m));
       j["held_out_best_rigid_starts"] = floor.starts;
     }
     auto& held_out = j["held_out_joints"] = nlohmann::json::array();
@@ -533,7 +534,7 @@ nlohmann::json calib_sim_run(const SimCalibOptions& o, const std::string& layout
     j["ambiguous"] = s->ambiguous;
     j["rotation_error_deg"] = deg;
     j["translation_error_cm"] = cm_off;
-    j["median_distance_cm"] = num(cm(s->median_m));
+    j["median_distance_cm"] = json_number(cm(s->median_m));
     // The same sensor calibrated directly against the reference alone (the pair method), for comparison.
     for (const auto& l : r.links) {
       if (l.a != ref || l.b != c.id) continue;
@@ -551,8 +552,8 @@ nlohmann::json calib_sim_run(const SimCalibOptions& o, const std::string& layout
       // distance to the reference's skeletons); how far it is from the truth, no calibration from them can undo.
       const auto low = calib::lowest_median_pose(by_sensor.at(ref), by_sensor.at(c.id), truth, 0, {}, 2.0);
       const auto [fd, fc] = pose_error(low.reference_from_other, truth);
-      j["floor"] = {{"rotation_error_deg", fd}, {"translation_error_cm", fc}, {"median_cm", num(cm(low.median_m))},
-                    {"median_at_truth_cm", num(cm(low.start_median_m))}};
+      j["floor"] = {{"rotation_error_deg", fd}, {"translation_error_cm", fc}, {"median_cm", json_number(cm(low.median_m))},
+                    {"median_at_truth_cm", json_number(cm(low.start_median_m))}};
     }
     sensors.push_back(j);
   }

@@ -345,9 +345,9 @@ int gesture_spot_model(const GestureOptions& o) {
     }
     out["per_class"] = per;
     out["macro_f1"] = macro;
-    out["median_latency_s"] = median(latencies);
+    out["median_latency_s"] = stats::median(latencies);
     if (!o.json) std::printf("macro F1 %.3f over %zu annotated streams; events a median %+.0f ms after the annotation\n", macro,
-                             annotated, 1e3 * median(latencies));
+                             annotated, 1e3 * stats::median(latencies));
   }
   if (o.json) std::printf("%s\n", out.dump(2).c_str());
   return bad.exit_code(0, expand_paths(o.inputs).size());
@@ -714,7 +714,7 @@ int gesture_sim(const GestureOptions& o) {
   std::sort(whole.begin(), whole.end());
   const auto within = [](const std::vector<double>& v) { return std::count_if(v.begin(), v.end(), [](double e) { return e <= 0.15; }); };
   const nlohmann::json whole_json{{"holds", whole.size()},
-                                  {"median_target_error_m", median(whole)},
+                                  {"median_target_error_m", stats::median(whole)},
                                   {"max_target_error_m", whole.empty() ? 0.0 : whole.back()},
                                   {"within_15_cm", within(whole)}};
   if (o.json) {
@@ -769,7 +769,7 @@ int gesture_sim(const GestureOptions& o) {
   if (!whole.empty())
     std::printf("reference, the fused joints averaged over each whole true hold: median error %.1f cm, largest %.1f cm, %td of %zu "
                 "within 15 cm\n",
-                100 * median(whole), 100 * whole.back(), within(whole), whole.size());
+                100 * stats::median(whole), 100 * whole.back(), within(whole), whole.size());
   return 0;
 }
 

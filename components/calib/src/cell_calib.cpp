@@ -1,4 +1,5 @@
 #include "skelgraph/calib/cell_calib.hpp"
+#include "skelgraph/skeleton/stats.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -221,7 +222,7 @@ CellCalibResult calibrate_cell(const std::map<std::string, std::vector<TimedSkel
       for (std::size_t q = 0; q < c.reference.size(); ++q) d.push_back((pose[i] * c.reference[q] - pose[k] * c.other[q]).norm());
       l.pairs = d.size();
       l.mirrored = c.mirrored;
-      l.median_m = median(d);
+      l.median_m = stats::upper_median(d);
       per_sensor[i].insert(per_sensor[i].end(), d.begin(), d.end());
       per_sensor[k].insert(per_sensor[k].end(), d.begin(), d.end());
     }
@@ -234,7 +235,7 @@ CellCalibResult calibrate_cell(const std::map<std::string, std::vector<TimedSkel
     s.reference_from_sensor = pose[i];
     s.path = path[i];
     s.pairs = per_sensor[i].size();
-    s.median_m = median(per_sensor[i]);
+    s.median_m = stats::upper_median(per_sensor[i]);
     double sq = 0;
     for (const double d : per_sensor[i]) sq += d * d, s.max_m = std::max(s.max_m, d);
     s.rms_m = per_sensor[i].empty() ? std::nan("") : std::sqrt(sq / static_cast<double>(per_sensor[i].size()));

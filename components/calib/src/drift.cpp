@@ -1,4 +1,5 @@
 #include "skelgraph/calib/drift.hpp"
+#include "skelgraph/skeleton/stats.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -81,7 +82,7 @@ void DriftMonitor::update(std::int64_t now_ns) {
         for (int k = 0; k < 3; ++k) {
           std::vector<double> x;
           for (const auto& d : v) x.push_back(d[k]);
-          m[k] = median(x);
+          m[k] = stats::upper_median(x);
         }
         return m;
       };

@@ -1,4 +1,5 @@
 #include "skelgraph/calib/robot_calib.hpp"
+#include "skelgraph/skeleton/stats.hpp"
 
 #include <algorithm>
 
@@ -40,15 +41,14 @@ RobotFit fit_board_on_tool(const std::vector<std::vector<Vector3d>>& corners_cam
 
 namespace {
 
-Vector3d median(std::vector<Vector3d> pts) {
+// Per axis, the upper median (stats.hpp).
+Vector3d median(const std::vector<Vector3d>& pts) {
   Vector3d m;
   for (int i = 0; i < 3; ++i) {
     std::vector<double> c;
     c.reserve(pts.size());
     for (const auto& p : pts) c.push_back(p[i]);
-    auto mid = c.begin() + static_cast<std::ptrdiff_t>(c.size() / 2);
-    std::nth_element(c.begin(), mid, c.end());
-    m[i] = *mid;
+    m[i] = stats::upper_median(std::move(c));
   }
   return m;
 }

@@ -1,4 +1,5 @@
 #include "skelgraph/calib/skeleton_calib.hpp"
+#include "skelgraph/skeleton/stats.hpp"
 
 #include <algorithm>
 #include <array>
@@ -13,13 +14,6 @@ namespace skelgraph::calib {
 using Eigen::Vector3d;
 using skeleton::JointId;
 using skeleton::Skeleton;
-
-double median(std::vector<double> v) {
-  if (v.empty()) return std::nan("");
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
-}
 
 namespace {
 
@@ -139,7 +133,7 @@ Fit fit_of(const Candidate& c, const Alignment& pose, const std::vector<JointId>
         agree += e <= thr ? 1 : 0;
       }
       if (d.size() < 3) continue;
-      const double m = median(d);
+      const double m = stats::upper_median(d);
       if (agree > best.agree || (agree == best.agree && m < best.median_m)) best = {agree, m, o, swapped};
     }
   }
@@ -211,7 +205,7 @@ Alignment propose(const std::vector<Candidate>& cs, const std::vector<JointId>& 
         score += f.agree;
         if (std::isfinite(f.median_m)) meds.push_back(f.median_m);
       }
-      const double med = median(meds);
+      const double med = stats::upper_median(meds);
       if (score > best_score || (score == best_score && med < best_med)) {
         best = pose;
         best_score = score;
@@ -270,7 +264,7 @@ SkeletonCalibResult solve(const std::vector<Candidate>& cs, Alignment pose, cons
     r.per_joint.clear();
     for (const auto j : joints) {
       auto& v = per[j];
-      JointResidual jr{j, v.size(), median(v), 0.0};
+      JointResidual jr{j, v.size(), stats::upper_median(v), 0.0};
       double ss = 0;
       for (double x : v) ss += x * x;
       jr.rms_m = v.empty() ? std::nan("") : std::sqrt(ss / static_cast<double>(v.size()));
@@ -333,7 +327,7 @@ double median_residual(const std::vector<Candidate>& cs, const Alignment& pose, 
   const Pairs p = pair_up(cs, pose, joints, o);
   std::vector<double> d;
   for (std::size_t i = 0; i < p.ref.size(); ++i) d.push_back((pose.apply(p.other[i]) - p.ref[i]).norm());
-  return d.size() < 10 ? std::numeric_limits<double>::infinity() : median(d);
+  return d.size() < 10 ? std::numeric_limits<double>::infinity() : stats::upper_median(d);
 }
 
 }  // namespace
@@ -449,7 +443,7 @@ std::vector<double> joint_distances(const std::vector<TimedSkeleton>& reference,
           if (tracked(*c.ref, j) && tracked(o, oj)) d.push_back((reference_from_other * o[oj].position - (*c.ref)[j].position).norm());
         }
         if (d.empty()) continue;
-        const double m = median(d);
+        const double m = stats::upper_median(d);
         if (m < best) best = m, best_d = std::move(d);
       }
     }
@@ -473,7 +467,7 @@ LowestMedian lowest_median_near(const std::vector<TimedSkeleton>& reference, con
     return Eigen::Isometry3d(d * start);
   };
   const auto cost = [&](const V6& x) {
-    const double m = median(joint_distances(reference, other, pose_of(x), clock_offset_ns, joints, max_match_m));
+    const double m = stats::upper_median(joint_distances(reference, other, pose_of(x), clock_offset_ns, joints, max_match_m));
     return std::isfinite(m) ? m : std::numeric_limits<double>::infinity();
   };
   LowestMedian out;

@@ -1,4 +1,5 @@
 #include "skelgraph/gesture/classifier.hpp"
+#include "skelgraph/skeleton/json_number.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -596,7 +597,6 @@ nlohmann::json roc_json(const std::vector<RocPoint>& r) {
   for (const auto& p : r) a.push_back({std::isfinite(p.threshold) ? nlohmann::json(p.threshold) : nlohmann::json(nullptr), p.tpr, p.fpr});
   return a;
 }
-nlohmann::json num(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 }  // namespace
 
 nlohmann::json to_json(const Metrics& m) {
@@ -612,8 +612,8 @@ nlohmann::json to_json(const Metrics& m) {
                                        {"unlabelled", m.unlabelled},
                                        {"unlabelled_rejected", m.unlabelled_rejected}}}};
   if (!m.detection_roc.empty())
-    j["detection"] = {{"class", m.labels[0]}, {"auc", num(m.detection_auc)}, {"roc_threshold_tpr_fpr", roc_json(m.detection_roc)}};
-  if (!m.rejection_roc.empty()) j["rejection"] = {{"auc", num(m.rejection_auc)}, {"roc_threshold_tpr_fpr", roc_json(m.rejection_roc)}};
+    j["detection"] = {{"class", m.labels[0]}, {"auc", json_number(m.detection_auc)}, {"roc_threshold_tpr_fpr", roc_json(m.detection_roc)}};
+  if (!m.rejection_roc.empty()) j["rejection"] = {{"auc", json_number(m.rejection_auc)}, {"roc_threshold_tpr_fpr", roc_json(m.rejection_roc)}};
   return j;
 }
 

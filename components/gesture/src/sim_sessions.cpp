@@ -144,8 +144,8 @@ void learn_joint_offsets(const std::vector<SimSession>& sessions, PointingCorrec
     }
   if (d[0][0].empty()) return;
   for (int k = 0; k < 3; ++k) {
-    c.shoulder[k] = median(d[0][k]);
-    c.hand[k] = median(d[1][k]);
+    c.shoulder[k] = stats::median(d[0][k]);
+    c.hand[k] = stats::median(d[1][k]);
   }
 }
 
@@ -358,8 +358,8 @@ Classifier train_on_sim(int sessions, std::uint64_t seed, const ClassifierOption
         }
     }
   if (!el.empty()) {
-    pc.elevation = median(el);
-    pc.azimuth_out = median(az);
+    pc.elevation = stats::median(el);
+    pc.azimuth_out = stats::median(az);
     model.set_pointing_correction(pc);
   }
   return model;

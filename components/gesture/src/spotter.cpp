@@ -1,4 +1,5 @@
 #include "skelgraph/gesture/spotter.hpp"
+#include "skelgraph/skeleton/json_number.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -16,13 +17,6 @@ constexpr JointId kArm[2][3] = {{JointId::LeftShoulder, JointId::LeftElbow, Join
 constexpr const char* kSideName[2] = {"left", "right"};
 
 }  // namespace
-
-double median(std::vector<double> v) {
-  if (v.empty()) return std::nan("");
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 const char* motion_state_name(MotionState s) {
   switch (s) {
@@ -411,16 +405,15 @@ void finish(SpottingReport& r) {
   r.precision = r.events ? static_cast<double>(r.true_positive) / r.events : 0.0;
   r.recall = r.truth ? static_cast<double>(r.true_positive) / r.truth : 0.0;
   r.f1 = r.precision + r.recall > 0 ? 2 * r.precision * r.recall / (r.precision + r.recall) : 0.0;
-  r.median_latency_s = median(r.latency_s);
-  r.median_latency_hold_s = median(r.latency_hold_s);
-  r.median_target_error_m = median(r.target_error_m);
-  r.median_ray_error_deg = median(r.ray_error_deg);
+  r.median_latency_s = stats::median(r.latency_s);
+  r.median_latency_hold_s = stats::median(r.latency_hold_s);
+  r.median_target_error_m = stats::median(r.target_error_m);
+  r.median_ray_error_deg = stats::median(r.ray_error_deg);
   r.max_target_error_m = r.target_error_m.empty() ? std::nan("") : *std::max_element(r.target_error_m.begin(), r.target_error_m.end());
   r.false_per_hour = r.non_gesture_s > 0 ? r.false_positive / (r.non_gesture_s / 3600.0) : std::nan("");
 }
 
 nlohmann::json to_json(const SpottingReport& r) {
-  const auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
   return {{"label", r.label},
           {"truth", r.truth},
           {"events", r.events},
@@ -430,13 +423,13 @@ nlohmann::json to_json(const SpottingReport& r) {
           {"precision", r.precision},
           {"recall", r.recall},
           {"f1", r.f1},
-          {"median_latency_s", num(r.median_latency_s)},
-          {"median_latency_from_hold_s", num(r.median_latency_hold_s)},
-          {"median_target_error_m", num(r.median_target_error_m)},
-          {"max_target_error_m", num(r.max_target_error_m)},
-          {"median_ray_error_deg", num(r.median_ray_error_deg)},
+          {"median_latency_s", json_number(r.median_latency_s)},
+          {"median_latency_from_hold_s", json_number(r.median_latency_hold_s)},
+          {"median_target_error_m", json_number(r.median_target_error_m)},
+          {"max_target_error_m", json_number(r.max_target_error_m)},
+          {"median_ray_error_deg", json_number(r.median_ray_error_deg)},
           {"non_gesture_hours", r.non_gesture_s / 3600.0},
-          {"false_per_hour", num(r.false_per_hour)},
+          {"false_per_hour", json_number(r.false_per_hour)},
           {"latency_s", r.latency_s},
           {"ray_error_deg", r.ray_error_deg},
           {"target_error_m", r.target_error_m}};

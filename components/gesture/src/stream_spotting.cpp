@@ -365,7 +365,7 @@ StreamSpotting cross_validate_streams(const std::vector<AnnotatedStream>& stream
     out.macro_f1 += out.per_class.back().f1 / static_cast<double>(out.classes.size());
     latencies.insert(latencies.end(), out.per_class.back().latency_s.begin(), out.per_class.back().latency_s.end());
   }
-  out.median_latency_s = median(latencies);
+  out.median_latency_s = stats::median(latencies);
   return out;
 }
 

@@ -128,6 +128,5 @@ LowestMedian lowest_median_pose(const std::vector<TimedSkeleton>& reference, con
                                 const Eigen::Isometry3d& start, std::int64_t clock_offset_ns = 0,
                                 const std::vector<skeleton::JointId>& joints = {}, double max_match_m = 1.0, int starts = 1);
 
-double median(std::vector<double> v);  // NaN when empty
 
 }  // namespace skelgraph::calib

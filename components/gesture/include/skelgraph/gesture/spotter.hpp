@@ -37,12 +37,12 @@
 
 #include "skelgraph/gesture/classifier.hpp"
 #include "skelgraph/skeleton/skeleton.hpp"
+#include "skelgraph/skeleton/stats.hpp"
 
 namespace skelgraph::gesture {
 
 enum class MotionState { Resting, Moving, Holding };
 
-double median(std::vector<double> v);  // NaN when empty
 const char* motion_state_name(MotionState s);
 
 // A plane the pointing ray may hit: points p with normal . (p - point) = 0.
