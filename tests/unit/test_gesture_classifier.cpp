@@ -5,6 +5,8 @@
 // on the real Kinder-Gator recordings in ../shared/data.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -531,4 +533,17 @@ TEST(StreamSpotting, FindsEachGestureNearItsActionPoint) {
   const auto h = cross_validate_streams(streams, c, o);
   EXPECT_EQ(h.per_class.size(), 2u);
   EXPECT_EQ(h.per_class[0].truth + h.per_class[1].truth, 36);
+}
+
+// The nearest-neighbour experiment's distance: a clip played slower is near
+// its original, another movement is not, nothing is infinitely far.
+TEST(Nearest, DtwForgivesSpeedNotShape) {
+  Sequence a(40, 2), slow(60, 2), other(40, 2);
+  for (int i = 0; i < 40; ++i) a.row(i) << std::sin(i * 0.15), std::cos(i * 0.15);
+  for (int i = 0; i < 60; ++i) slow.row(i) << std::sin(i * 0.1), std::cos(i * 0.1);
+  for (int i = 0; i < 40; ++i) other.row(i) << std::cos(i * 0.3), 0.5;
+  EXPECT_DOUBLE_EQ(dtw_distance(a, a, 0.2), 0.0);
+  EXPECT_LT(dtw_distance(a, slow, 0.2), 0.02);
+  EXPECT_GT(dtw_distance(a, other, 0.2), 10 * dtw_distance(a, slow, 0.2));
+  EXPECT_TRUE(std::isinf(dtw_distance(a, Sequence(0, 2), 0.2)));
 }

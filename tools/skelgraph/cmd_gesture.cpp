@@ -40,6 +40,7 @@ struct GestureOptions {
   bool no_trim = false;
   bool per_class = false;
   bool prefixes = false;
+  bool nearest = false;  // cv: the DTW nearest-neighbour experiment instead of the HMMs
   double reject_quantile = 0.02;
   int iterations = 100;
   double tolerance = 1e-4;
@@ -88,6 +89,7 @@ ClassifierOptions classifier_options(const GestureOptions& o) {
   c.hmm.tolerance = o.tolerance;
   c.hmm.init = o.init == "kmeans" ? Init::KMeans : Init::Segments;
   c.hmm.restarts = o.restarts;
+  c.nearest = o.nearest;
   c.hmm.seed = o.seed;
   c.garbage_mixtures = o.garbage_mixtures;
   c.features.set = *feature_set_from_name(o.features);
@@ -885,6 +887,9 @@ void add_gesture_command(CLI::App& app, GlobalOptions&, Action& run) {
                      "the inputs are annotated continuous streams (an .annotations.csv beside each file, or --format msrc12's "
                      ".tagstream): leave one subject out, spot with a sliding window, score events against the annotations "
                      "(per class P/R/F1, macro F1, latency); --features defaults to body here");
+  cv->add_flag("--nearest", o->nearest,
+               "an experiment: each clip takes the class of its nearest training clip by dynamic time warping (the "
+               "features and --hands as given; the HMM options unused); cross-validation only");
   cv->add_option("--split", o->split, "lso: leave one subject out (default); kfold: stratified k-fold")
       ->check(CLI::IsMember({"lso", "kfold"}));
   cv->add_option("--folds", o->folds, "k for --split kfold (default 5)")->check(CLI::Range(2, 1000));

@@ -261,6 +261,7 @@ nlohmann::json ClassMap::to_json() const {
 // --- Classifier ---
 
 Classifier Classifier::train(const std::vector<Clip>& clips, const ClassMap& map, const ClassifierOptions& o) {
+  if (o.nearest) throw ModelError("the nearest-neighbour (DTW) classifier is a cross-validation experiment: it cannot be trained into a model yet");
   std::vector<const Clip*> all;
   for (const auto& c : clips) all.push_back(&c);
   Classifier c;
@@ -448,9 +449,75 @@ std::vector<int> assign_folds(const std::vector<Clip>& clips, const CvOptions& c
   return fold;
 }
 
+// The nearest-neighbour experiment's fold: each held-out clip scores, per
+// class, minus its DTW distance to that class's nearest training clip.
+std::vector<ClipResult> run_fold_nearest(const std::vector<Clip>& clips, const std::vector<int>& fold, int f,
+                                         const ClassMap& map, const ClassifierOptions& o) {
+  std::vector<Sequence> train;
+  std::vector<int> label;
+  for (std::size_t i = 0; i < clips.size(); ++i)
+    if (fold[i] != f && clips[i].label >= 0) {
+      train.push_back(prepared(clips[i].x, o.hands, o.features.set));
+      label.push_back(clips[i].label);
+    }
+  if (train.empty()) throw ModelError("nearest: no training clips in a fold");
+  // Standardise every feature over the training frames.
+  const auto d = train.front().cols();
+  Eigen::VectorXd mean = Eigen::VectorXd::Zero(d), sq = Eigen::VectorXd::Zero(d);
+  double n = 0;
+  for (const auto& x : train) {
+    mean += x.colwise().sum().transpose();
+    sq += x.array().square().colwise().sum().matrix().transpose();
+    n += static_cast<double>(x.rows());
+  }
+  mean /= n;
+  Eigen::VectorXd sd = (sq / n - mean.cwiseProduct(mean)).cwiseMax(0).cwiseSqrt();
+  for (Eigen::Index k = 0; k < d; ++k)
+    if (sd[k] < 1e-9) sd[k] = 1;
+  const auto standard = [&](Sequence x) {
+    for (Eigen::Index r = 0; r < x.rows(); ++r) x.row(r) = (x.row(r).transpose() - mean).cwiseQuotient(sd).transpose();
+    return x;
+  };
+  for (auto& x : train) x = standard(x);
+  const auto K = map.classes.size();
+  const auto score = [&](const Sequence& x, std::size_t skip) {
+    std::vector<double> s(K, -std::numeric_limits<double>::infinity());
+    for (std::size_t t = 0; t < train.size(); ++t) {
+      if (t == skip) continue;
+      auto& v = s[static_cast<std::size_t>(label[t])];
+      v = std::max(v, -dtw_distance(x, train[t], o.nearest_band));
+    }
+    return s;
+  };
+  const auto decision = [&](std::vector<double> s, double threshold) {
+    Decision dd;
+    dd.scores = std::move(s);
+    const auto best = std::max_element(dd.scores.begin(), dd.scores.end());
+    dd.label = static_cast<int>(best - dd.scores.begin());
+    double second = -std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k < K; ++k)
+      if (static_cast<int>(k) != dd.label) second = std::max(second, dd.scores[k]);
+    dd.margin = K > 1 ? *best - second : 0.0;
+    dd.rejected = dd.label != map.garbage_index() && (!std::isfinite(*best) || *best < threshold);
+    return dd;
+  };
+  // The threshold: each training clip's score against the others (leave one out).
+  std::vector<double> own;
+  for (std::size_t t = 0; t < train.size(); ++t)
+    if (label[t] != map.garbage_index()) own.push_back(score(train[t], t)[static_cast<std::size_t>(label[t])]);
+  const double threshold = quantile(own, o.reject_quantile);
+  std::vector<ClipResult> out;
+  for (std::size_t i = 0; i < clips.size(); ++i)
+    if (fold[i] == f)
+      out.push_back({i, clips[i].label,
+                     decision(score(standard(prepared(clips[i].x, o.hands, o.features.set)), train.size()), threshold), f});
+  return out;
+}
+
 // Train on the clips outside fold f, score those in it (one thread).
 std::vector<ClipResult> run_fold(const std::vector<Clip>& clips, const std::vector<int>& fold, int f, const ClassMap& map,
                                  const ClassifierOptions& o) {
+  if (o.nearest) return run_fold_nearest(clips, fold, f, map, o);
   ClassifierOptions one = o;
   one.threads = 1;
   std::vector<const Clip*> train;
@@ -480,6 +547,25 @@ std::vector<ClipResult> merged(std::vector<std::vector<ClipResult>>& per_fold) {
 }
 
 }  // namespace
+
+double dtw_distance(const Sequence& a, const Sequence& b, double band) {
+  const Eigen::Index n = a.rows(), m = b.rows();
+  if (n == 0 || m == 0) return std::numeric_limits<double>::infinity();
+  const Eigen::Index w = std::max<Eigen::Index>(std::abs(n - m), static_cast<Eigen::Index>(band * static_cast<double>(std::max(n, m))));
+  const double inf = std::numeric_limits<double>::infinity();
+  std::vector<double> prev(static_cast<std::size_t>(m + 1), inf), cur(static_cast<std::size_t>(m + 1), inf);
+  prev[0] = 0;
+  for (Eigen::Index i = 1; i <= n; ++i) {
+    std::fill(cur.begin(), cur.end(), inf);
+    for (Eigen::Index j = std::max<Eigen::Index>(1, i - w); j <= std::min(m, i + w); ++j) {
+      const double c = (a.row(i - 1) - b.row(j - 1)).norm();
+      const auto ju = static_cast<std::size_t>(j);
+      cur[ju] = c + std::min({prev[ju], prev[ju - 1], cur[ju - 1]});
+    }
+    std::swap(prev, cur);
+  }
+  return prev[static_cast<std::size_t>(m)] / static_cast<double>(n + m);
+}
 
 std::vector<ClipResult> cross_validate(const std::vector<Clip>& clips, const ClassMap& map, const ClassifierOptions& o,
                                        const CvOptions& cv, const std::function<void(int, int)>& progress) {

@@ -70,7 +70,18 @@ struct ClassifierOptions {
   double reject_quantile = 0.02;     // the threshold accepts this share less than all held-out training clips
   int calibration_folds = 3;         // held-out scores for the threshold come from this many inner folds (0: training scores)
   int threads = 2;
+  // Cross-validation only, an experiment beside the HMMs: each clip takes the
+  // class of its nearest training clip by dynamic time warping (features
+  // standardised over the training frames; Sakoe-Chiba band of `nearest_band`
+  // of the longer clip). Classifier::train refuses it.
+  bool nearest = false;
+  double nearest_band = 0.2;
 };
+
+// Dynamic time warping: the Euclidean frame distances summed along the best
+// alignment within a band of `band` x the longer length (at least their
+// difference), divided by the two lengths' sum. +inf when either is empty.
+double dtw_distance(const Sequence& a, const Sequence& b, double band);
 
 struct Decision {
   int label = -1;                 // the best class
