@@ -5,6 +5,7 @@
 #include <cmath>
 #include <map>
 #include <set>
+#include <tuple>
 
 #include "skelgraph/sim/rng.hpp"
 #include "skelgraph/sim/scenario.hpp"
@@ -319,6 +320,47 @@ TEST(SimTracker, HiddenJointsAreInferredByMssdkButClaimedByNite) {
   ASSERT_GT(ms_hidden, 90);
   EXPECT_LT(ms_claimed, ms_hidden / 3);
   EXPECT_GT(nite_claimed, nite_hidden * 3 / 4);
+}
+
+// Something that is no person (a robot's link, Simulation::set_occluders)
+// standing between the sensor and the person hides the joints behind it:
+// the tracker loses a person hidden whole.
+TEST(SimTracker, AnOccluderHidesTheJointsBehindIt) {
+  auto cfg = one_sensor("walk", "mssdk");
+  cfg.noise_scale = 0.0;
+  const auto sensor = cfg.sensors[0].position;
+  const auto hands = [&](bool occluded) {
+    sim::Simulation sim(cfg);
+    int frames = 0, inferred = 0;
+    double nearest = 1e9;
+    for (double t = 1.0; t < 6.0; t += 1.0 / 30) {
+      if (occluded) {
+        // A 30 cm thick pillar from the floor to 2.5 m, halfway between the sensor and the person.
+        const auto person = sim.truth_at(t)[0][JointId::Torso].position;
+        const Eigen::Vector3d mid = 0.5 * (sensor + person);
+        sim.set_occluders({{Eigen::Vector3d(mid.x(), 0.0, mid.z()), Eigen::Vector3d(mid.x(), 2.5, mid.z()), 0.3}});
+      }
+      for (const auto& e : sim.advance(t)) {
+        if (e.kind != sim::SimEvent::Kind::Raw) continue;
+        ++frames;
+        inferred += e.skeleton[JointId::Torso].confidence != skeleton::kTracked;
+        nearest = std::min(nearest, e.skeleton[JointId::RightHand].position.norm());
+      }
+    }
+    return std::tuple{frames, inferred, nearest};
+  };
+  const auto [clear_frames, clear_inferred, clear_nearest] = hands(false);
+  const auto [hidden_frames, hidden_inferred, hidden_nearest] = hands(true);
+  ASSERT_GT(clear_frames, 100);
+  EXPECT_EQ(clear_inferred, 0);
+  EXPECT_GT(clear_nearest, 1.0);
+  // Hidden whole: the tracker loses the person (as behind the partition of `occ`), or what it
+  // still reports of them lands on the pillar, nearer to the sensor.
+  EXPECT_LT(hidden_frames, clear_frames / 2) << hidden_frames << " frames, nearest hand " << hidden_nearest;
+  if (hidden_frames > 0) {
+    EXPECT_LT(hidden_nearest, clear_nearest);
+  }
+  (void)hidden_inferred;
 }
 
 TEST(Simulation, SeededRunsAreBitIdenticalAndSeedsDiffer) {

@@ -29,6 +29,7 @@ struct SafetyOptions {
   double capture_latency_ms = 50.0;
   double release_ms = 500.0;
   double uncertainty_scale = 1.0;
+  bool no_arm_hides = false;
   bool follow = false;
   std::vector<std::string> dropouts;  // SENSOR,EVERY_S,FOR_S
   int min_sensors = 2;  // robot_cell.yaml's: with three of four sensors silent at once, 1 let the arm move too close
@@ -113,6 +114,7 @@ int eval_safety(const SafetyOptions& o) {
       so.command_latency_s = o.command_latency_ms * 1e-3;
       so.release_s = o.release_ms * 1e-3;
       so.uncertainty_scale = o.uncertainty_scale;
+      so.arm_hides = !o.no_arm_hides;
       so.min_sensors = o.min_sensors;
       for (const auto& spec : o.dropouts) so.dropouts.push_back(parse_dropout(spec, so.sim));
       if (o.follow) {
@@ -153,6 +155,7 @@ int eval_safety(const SafetyOptions& o) {
     std::printf("%s\n", nlohmann::json{{"method", o.method},
                                        {"release_ms", o.release_ms},
                                        {"uncertainty_scale", o.uncertainty_scale},
+                                       {"arm_hides", !o.no_arm_hides},
                                        {"command_latency_ms", o.command_latency_ms},
                                        {"capture_latency_ms", o.capture_latency_ms},
                                        {"runs", runs},
@@ -243,6 +246,8 @@ void add_eval_safety_command(CLI::App& eval, Action& run) {
   c->add_option("--capture-latency-ms", o->capture_latency_ms, "the trackers' own delay (NITE about 50)")->check(CLI::Range(0.0, 1000.0));
   c->add_option("--release-ms", o->release_ms, "after a stop, the way must be clear this long (the separation component's release_ms)")
       ->check(CLI::Range(0.0, 10000.0));
+  c->add_flag("--no-arm-hides", o->no_arm_hides,
+              "the sensors see through the arm (as before 2026-12-05: the simulator did not draw it)");
   c->add_option("--uncertainty-scale", o->uncertainty_scale,
                 "Z_d is the fused joints' 95 % radius times this (1, as the separation component; 0 leaves it out, to see what it costs)")
       ->check(CLI::Range(0.0, 10.0));

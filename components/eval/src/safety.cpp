@@ -94,6 +94,12 @@ SafetyRunResult run_safety(const SafetyRunOptions& o) {
   for (std::uint64_t k = 0; k < steps; ++k) {
     const double now = static_cast<double>(k) * dt;
     const std::int64_t now_ns = std::llround(now * 1e9);
+    // The arm where it is now hides whoever is behind it from the sensors.
+    if (o.arm_hides) {
+      std::vector<sim::Capsule> links;
+      for (const auto& c : arm.capsules()) links.push_back({c.a, c.b, c.radius});
+      sim.set_occluders(std::move(links));
+    }
     // What reached fusion by now (a hop after the sensor delivered it).
     for (auto& e : sim.advance(now - o.hop_s)) {
       const std::int64_t arrival = std::llround((e.t + o.hop_s) * 1e9);

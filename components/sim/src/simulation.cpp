@@ -145,7 +145,8 @@ void Simulation::emit_raw(std::size_t i, double t, std::vector<SimEvent>& out) {
     moved.position += b.shift_m * (st.config.world_from_sensor().linear() * Eigen::Vector3d::UnitX());
     for (auto& tracker : st.trackers) tracker->move_sensor(moved);
   }
-  const Scene scene = scenario_.at(t);
+  Scene scene = scenario_.at(t);
+  scene.occluders = occluders_;
   std::vector<skeleton::Skeleton> truths;
   for (const auto& a : scene.actors) truths.push_back(forward_kinematics(body_, a.pose));
   ++st.frame;

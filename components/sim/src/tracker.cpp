@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 namespace skelgraph::sim {
@@ -66,17 +67,17 @@ double segment_distance(const Vector3d& p1, const Vector3d& q1, const Vector3d& 
   return ((p1 + d1 * s) - (p2 + d2 * t)).norm();
 }
 
-struct Capsule {
+struct BodyCapsule {
   Vector3d a, b;
   double r;
   JointId ja, jb;  // the joints it joins (the trunk: hips' midpoint counts as Torso)
 };
 
 // The body as capsules: trunk and head first (what can hide the person's own limbs), then the limbs.
-std::vector<Capsule> capsules(const skeleton::Skeleton& s, double scale) {
+std::vector<BodyCapsule> capsules(const skeleton::Skeleton& s, double scale) {
   auto P = [&s](JointId j) { return s[j].position; };
   const Vector3d pelvis = 0.5 * (P(JointId::LeftHip) + P(JointId::RightHip));
-  std::vector<Capsule> c{{pelvis, P(JointId::Neck), 0.13 * scale, JointId::Torso, JointId::Neck},
+  std::vector<BodyCapsule> c{{pelvis, P(JointId::Neck), 0.13 * scale, JointId::Torso, JointId::Neck},
                          {P(JointId::Head), P(JointId::Head), 0.10 * scale, JointId::Head, JointId::Head}};
   for (auto [a, b, r] : {std::tuple{JointId::LeftShoulder, JointId::LeftElbow, 0.05},
                          {JointId::LeftElbow, JointId::LeftHand, 0.045},
@@ -183,7 +184,7 @@ Visibility visibility(const SensorView& view, const Scene& scene, std::size_t ac
                       const std::vector<skeleton::Skeleton>& truths, double body_scale) {
   Visibility v;
   const Vector3d origin = view.config().position;
-  std::vector<std::vector<Capsule>> bodies;
+  std::vector<std::vector<BodyCapsule>> bodies;
   for (const auto& s : truths) bodies.push_back(capsules(s, body_scale));
   int sighted = 0, hidden = 0, by_props = 0;
   for (std::size_t j = 0; j < kJointCount; ++j) {
@@ -206,6 +207,16 @@ Visibility visibility(const SensorView& view, const Scene& scene, std::size_t ac
           v.hit_depth[j] = std::min(v.hit_depth[j], std::max(0.1, s * (end - origin).norm() - c.r));
           break;
         }
+      }
+    }
+    // Behind something that is no person (a robot's link): hidden like behind a prop.
+    for (std::size_t k = 0; k < scene.occluders.size() && !blocked; ++k) {
+      const auto& c = scene.occluders[k];
+      double s = 0;
+      if (segment_distance(origin, end, c.a, c.b, &s) < c.radius) {
+        blocked = true;
+        if (j <= idx(JointId::RightHand)) ++by_props;
+        v.hit_depth[j] = std::min(v.hit_depth[j], std::max(0.1, s * (end - origin).norm() - c.radius));
       }
     }
     v.object_hidden[j] = blocked;

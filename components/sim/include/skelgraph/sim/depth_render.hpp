@@ -29,12 +29,6 @@ struct DepthNoise {
   double min_range_m = 0.5, max_range_m = 8.0;
 };
 
-// One body segment: the points within `radius` of the segment a-b.
-struct Capsule {
-  Eigen::Vector3d a, b;
-  double radius = 0.05;
-};
-
 // The body's volume around a (true, world-frame) skeleton, scaled by body
 // height: head, neck, trunk, arms, hands, legs as capsules. `girth` scales
 // every radius but the head's (builds differ: 0.85 slim .. 1.25 stout).

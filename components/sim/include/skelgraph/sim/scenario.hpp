@@ -29,10 +29,19 @@ struct Actor {
   std::size_t slot = 0;  // the place in the cell (one tracker per sensor and place); people in turn take a place
 };
 
+// One body segment: the points within `radius` of the segment a-b.
+struct Capsule {
+  Eigen::Vector3d a, b;
+  double radius = 0.05;
+};
+
 struct Scene {
   double t = 0.0;  // s since the start of the scenario
   std::vector<Actor> actors;
   std::vector<Obstacle> obstacles;
+  // Things that move and hide people but are none (a robot's links, world
+  // frame): set from outside the scenario (Simulation::set_occluders).
+  std::vector<Capsule> occluders;
 };
 
 struct ScenarioOptions {

@@ -72,6 +72,9 @@ class Simulation {
   std::size_t frame_count(std::size_t sensor) const;
   // Ground truth of every person at world time t.
   std::vector<skeleton::Skeleton> truth_at(double t) const;
+  // What else hides people from the sensors from now on (a robot's links,
+  // world frame; Scene::occluders): the sensors' frames after this see them.
+  void set_occluders(std::vector<Capsule> occluders) { occluders_ = std::move(occluders); }
 
  private:
   struct SensorState;
@@ -84,6 +87,7 @@ class Simulation {
   std::vector<std::unique_ptr<SensorState>> sensors_;
   std::uint64_t truth_frame_ = 0;
   std::vector<std::uint32_t> truth_present_;  // people in the last truth frame (emit_departures)
+  std::vector<Capsule> occluders_;
 };
 
 }  // namespace skelgraph::sim
