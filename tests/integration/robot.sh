@@ -21,6 +21,8 @@ sep, robot = d["separation"]["details"], d["robot"]["details"]
 by = sep["steps_by_state"]
 # The arm works round its task points; the worker walks close by: the monitor slows and stops it, and lets it go again.
 assert robot["task_points_reached"] >= 1, robot
+# The simulated sensors see the arm's links (they hide the worker behind them).
+assert d["sim"]["details"]["robot_links_hiding"] == 7, d["sim"]["details"]
 assert by.get("PROTECTIVE_STOP", 0) > 0 and by.get("RUN", 0) + by.get("REDUCED", 0) > 0, by
 # (the last command or two may be sent while the graph shuts down)
 assert sep["failed_writes"] == 0 and robot["protective_stops"] >= 1 and sep["commands"] - 2 <= robot["commands"] <= sep["commands"], (sep, robot)

@@ -87,6 +87,7 @@ runtime::ComponentInfo SimComponent::describe() {
       .add_bool("depth_noise", true, "Kinect-like depth errors: disparity noise and quantisation, drop-outs, missing edges")
       .add_double("depth_girth", 1.1, "build of the people in the depth images (1: standard capsules; 0.85 slim, 1.25 stout)", 0.5, 2.0)
       .add_bool("publish_poses", true, "publish the sensors' true poses (off: a calibration file or component provides them)")
+      .add_bool("robot_hides", true, "a robot's links (skelgraph/robot/state) hide the people behind them from the sensors")
       .add_bool("wall_clock_aligned", false,
                 "scenario time = wall clock modulo the scenario's duration, so sims started at different times (or "
                 "restarted) agree on where the person is; implies loop");
@@ -125,6 +126,22 @@ SimComponent::SimComponent(runtime::Context& ctx, const runtime::Params& params)
   }
   publish_poses_ = params.get<bool>("publish_poses");
   aligned_ = params.get<bool>("wall_clock_aligned");
+  if (params.get<bool>("robot_hides")) {
+    robot_sub_ = std::make_unique<runtime::Subscription<msg::RobotState>>(
+        ctx, runtime::topics::kRobotState, [this](const msg::RobotState& r, const runtime::SampleMeta&) {
+          auto& links = robot_links_[r.robot_id().to_string()];
+          links.clear();
+          for (const auto& c : r.capsules())
+            links.push_back({{c.a().x(), c.a().y(), c.a().z()}, {c.b().x(), c.b().y(), c.b().z()}, c.radius()});
+          if (sim_) sim_->set_occluders(all_robot_links());
+        });
+  }
+}
+
+std::vector<Capsule> SimComponent::all_robot_links() const {
+  std::vector<Capsule> out;
+  for (const auto& [id, links] : robot_links_) out.insert(out.end(), links.begin(), links.end());
+  return out;
 }
 
 bool SimComponent::publishes(std::size_t sensor) const {
@@ -159,6 +176,7 @@ void SimComponent::on_start() {
     skip_before_s_ = static_cast<double>(into) * 1e-9 * rate_;
   }
   sim_ = std::make_unique<Simulation>(config_);
+  sim_->set_occluders(all_robot_links());
   publish_poses();
   timer_ = ctx_.executor().every(std::chrono::milliseconds(5), [this] { tick(); }, true);
 }
@@ -202,6 +220,7 @@ void SimComponent::tick() {
     SimConfig next = config_;
     next.epoch_ns = config_.epoch_ns + std::llround(loop_offset_s_ * 1e9);
     sim_ = std::make_unique<Simulation>(next);
+    sim_->set_occluders(all_robot_links());
     return;
   }
   finished_ = true;
@@ -235,6 +254,7 @@ nlohmann::json SimComponent::details() const {
           {"capture_latency_ms", TrackerProfile::by_name(config_.profile).lag_s * 1e3},
           {"people", config_.scenario.people},
           {"duration_s", sim_->duration()},
+          {"robot_links_hiding", all_robot_links().size()},
           {"sensors", sensors},
           {"truth_published", truth_published_},
           {"raw_published", raw_published_},

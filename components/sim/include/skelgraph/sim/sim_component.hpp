@@ -6,6 +6,7 @@
 // `depth`, also each sensor's depth image on skelgraph/depth (depth_render.hpp).
 
 #include <atomic>
+#include <map>
 #include <memory>
 
 #include "skelgraph/runtime/component.hpp"
@@ -53,6 +54,10 @@ class SimComponent final : public runtime::Component {
   std::uint64_t truth_published_ = 0, raw_published_ = 0, depth_published_ = 0, runs_completed_ = 0;
   std::uint64_t departures_ = 0, users_lost_ = 0;  // truth and raw instances disposed
   std::atomic<bool> finished_{false};
+  // A robot's links (skelgraph/robot/state) hide people from the sensors (`robot_hides`).
+  std::map<std::string, std::vector<Capsule>> robot_links_;  // per robot id
+  std::vector<Capsule> all_robot_links() const;
+  std::unique_ptr<runtime::Subscription<msg::RobotState>> robot_sub_;
 };
 
 // Builds the simulation's configuration from the component's parameters
