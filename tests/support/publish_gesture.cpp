@@ -34,6 +34,11 @@ int main(int argc, char** argv) {
   e.ray_direction().y(-std::sqrt(0.5));
   e.target().x(1.4);
   e.target_name("floor");
+  // Events are not kept for late joiners (volatile): first a reader to hear them.
+  if (!pub.wait_for_matched(1, std::chrono::seconds(20))) {
+    std::fprintf(stderr, "publish_gesture: no reader of skelgraph/gesture/event within 20 s\n");
+    return 1;
+  }
   const int count = static_cast<int>(seconds * 2);
   for (int i = 0; i < count; ++i) {
     e.start_stamp_ns(runtime::system_clock()->now_ns() - 500'000'000);
