@@ -67,3 +67,37 @@ grep -q "b.raw: 1000 bytes; a raw 640 x 480 uint16 image has 614400" "$WORK/bad3
   || fail "the truncated image is not named: $(cat "$WORK/bad3.out" "$WORK/bad3.err")"
 grep -q "published\|1 published" "$WORK/bad3.out" && fail "frames went out before the bad file was found: $(cat "$WORK/bad3.out")"
 ok "bad input named: a raw image without a size, a truncated one"
+
+# The tracker on the real images (issue 35): close views from the waist up, no floor in sight, cut off below.
+"$S" depth track "$SK" --width 640 --height 480 --each-alone --json >"$WORK/track.json" 2>"$WORK/track.err" ||
+  fail "depth track: $(tail -3 "$WORK/track.err")"
+python3 - "$WORK/track.json" <<'PY' || fail "the tracker on skeltrack-depth (above)"
+import json, sys
+d = json.load(open(sys.argv[1]))
+problems = []
+if d["with_a_person"] != 12: problems.append(f'{d["with_a_person"]} of 12 images with a person')
+# The nearest person's reported joints on the person (measured 2026-12-05: 115 of 131); the legs, below the image, not reported.
+share = d["nearest_joints_on_person"] / max(1, d["nearest_joints_reported"])
+if share < 0.8: problems.append(f"only {share:.0%} of the joints on the person")
+for f in d["files"]:
+    for s in f["skeletons"]:
+        if s["nearest"] and any(j in s["joints"] for j in ("left_foot", "right_foot")):
+            problems.append(f'{f["file"]}: a foot reported in a view cut off at the waist')
+# Bones the same length in every image (measured: sd 0.4-1.5 cm).
+for name, b in d["bones"].items():
+    if b["images"] < 10 or b["sd_m"] > 0.03: problems.append(f'{name}: {b}')
+print("\n".join(problems), file=sys.stderr)
+sys.exit(1 if problems else 0)
+PY
+ok "depth track on skeltrack-depth: $(json_get "$WORK/track.json" 'd["with_a_person"]') of 12 images with the person, $(json_get "$WORK/track.json" 'd["nearest_joints_on_person"]') of $(json_get "$WORK/track.json" 'd["nearest_joints_reported"]') joints on the person"
+
+# ... and through fusion from the launch file (its pose assumed level: bringup/calib/depth_level.yaml).
+"$S" launch "$SRC/bringup/depth_files.yaml" --set viewer.port=0 --duration 8 --json >"$WORK/launch.json" 2>"$WORK/launch.err" ||
+  fail "depth_files.yaml: $(tail -3 "$WORK/launch.err")"
+json_check "$WORK/launch.json" '[c for c in d["components"] if c["name"] == "depth_tracker"][0]["details"]["sensors"]["depth1"]["skeletons"] > 0'
+python3 - "$WORK/launch.json" <<'PY' || fail "no fused skeleton from the real images: $(grep -h 'fusion' "$WORK/launch.err" | tail -2)"
+import json, sys
+d = {c["name"]: c for c in json.load(open(sys.argv[1]))["components"]}
+sys.exit(0 if " 0 fused skeletons" not in d["fusion"]["summary"] else 1)
+PY
+ok "bringup/depth_files.yaml: real depth -> tracker -> fusion"

@@ -2,6 +2,8 @@
 // summarised (no DDS), or played on skelgraph/depth (the depth_files component).
 
 #include <algorithm>
+#include <cmath>
+#include <map>
 #include <cstdio>
 #include <memory>
 
@@ -10,6 +12,7 @@
 #include "cli.hpp"
 #include "run_graph.hpp"
 #include "skelgraph/depth/depth_files.hpp"
+#include "skelgraph/depth_tracker/tracker.hpp"
 
 namespace skelgraph::cli {
 
@@ -20,6 +23,8 @@ struct DepthOpts {
   int width = 0, height = 0;
   double rate = 30.0, speed = 1.0;
   bool loop = false, paused = false, json = false;
+  double sensor_height = 1.2, on_person_m = 0.05;
+  bool each_alone = false;
   RunOptions run;
 };
 
@@ -97,6 +102,113 @@ int info(const DepthOpts& o) {
   return bad.exit_code(0, folder->size());
 }
 
+// The tracker over a folder, offline: per image the people found and whether
+// each reported joint of the nearest lies on the person (its pixel has a
+// reading and the joint is no more than `on_person_m` in front of it); per
+// bone of the nearest person, its length's spread over the images.
+int track(const DepthOpts& o) {
+  std::unique_ptr<depth::DepthFolder> folder;
+  try {
+    folder = std::make_unique<depth::DepthFolder>(o.dir, files_options(o));
+  } catch (const std::exception& e) {
+    throw UsageError(e.what());
+  }
+  depth_tracker::TrackerOptions topt;
+  depth_tracker::DepthTracker tracker(topt);
+  Eigen::Isometry3d level = Eigen::Isometry3d::Identity();  // a level sensor, sensor_height above the floor
+  level.translation() = Eigen::Vector3d(0.0, o.sensor_height, 0.0);
+  tracker.set_pose(level);
+  BadInputs bad;
+  nlohmann::json images = nlohmann::json::array();
+  std::map<std::string, std::vector<double>> bones;
+  std::size_t with_one = 0, with_any = 0, joints_reported = 0, joints_on = 0;
+  const std::vector<std::pair<skeleton::JointId, skeleton::JointId>> bone_list = {
+      {skeleton::JointId::Neck, skeleton::JointId::Head},           {skeleton::JointId::LeftShoulder, skeleton::JointId::RightShoulder},
+      {skeleton::JointId::LeftShoulder, skeleton::JointId::LeftElbow}, {skeleton::JointId::LeftElbow, skeleton::JointId::LeftHand},
+      {skeleton::JointId::RightShoulder, skeleton::JointId::RightElbow}, {skeleton::JointId::RightElbow, skeleton::JointId::RightHand}};
+  for (std::size_t i = 0; i < folder->size(); ++i) {
+    depth::DepthImage img;
+    if (!bad.guard([&] {
+          try {
+            img = folder->read(i);
+          } catch (const std::invalid_argument& e) {
+            throw UsageError(e.what());
+          }
+        }))
+      continue;
+    img.stamp_ns = folder->offset_ns(i);
+    if (o.each_alone) {  // snapshots, not a recording: nobody carried over from the image before
+      tracker = depth_tracker::DepthTracker(topt);
+      tracker.set_pose(level);
+    }
+    const auto people = tracker.track(img);
+    nlohmann::json f{{"file", folder->file(i)}, {"people", people.size()}};
+    if (people.size() == 1) ++with_one;
+    if (!people.empty()) ++with_any;
+    // The nearest person is the one the image is of (the others: whatever else the image holds).
+    std::size_t nearest = 0;
+    for (std::size_t k = 1; k < people.size(); ++k)
+      if (people[k][skeleton::JointId::Torso].position.z() < people[nearest][skeleton::JointId::Torso].position.z()) nearest = k;
+    nlohmann::json ps = nlohmann::json::array();
+    for (std::size_t k = 0; k < people.size(); ++k) {
+      const auto& s = people[k];
+      nlohmann::json joints = nlohmann::json::object();
+      std::size_t on = 0, reported = 0;
+      for (std::size_t j = 0; j < skeleton::kJointCount; ++j) {
+        const auto& jt = s.joints[j];
+        if (jt.confidence <= 0) continue;
+        ++reported;
+        const auto px = depth::project(img.intrinsics, jt.position);
+        const int u = static_cast<int>(std::lround(px.x())), v = static_cast<int>(std::lround(px.y()));
+        bool on_person = false;
+        if (u >= 0 && v >= 0 && u < img.width() && v < img.height()) {
+          const auto mm = img.mm[static_cast<std::size_t>(v) * static_cast<std::size_t>(img.width()) + static_cast<std::size_t>(u)];
+          on_person = mm > 0 && jt.position.z() >= mm * 1e-3 - o.on_person_m;
+        }
+        on += on_person;
+        joints[skeleton::joint_name(skeleton::joint_at(j))] = {
+            {"pixel", {px.x(), px.y()}}, {"confidence", jt.confidence}, {"on_person", on_person}};
+      }
+      if (k != nearest) {
+        ps.push_back({{"person", s.person_id}, {"nearest", false}, {"joints_reported", reported}, {"joints_on_person", on}, {"joints", joints}});
+        continue;
+      }
+      joints_reported += reported;
+      joints_on += on;
+      for (const auto& [a, b] : bone_list) {
+        if (s[a].confidence <= 0 || s[b].confidence <= 0) continue;
+        bones[std::string(skeleton::joint_name(a)) + "-" + skeleton::joint_name(b)].push_back((s[a].position - s[b].position).norm());
+      }
+      ps.push_back({{"person", s.person_id}, {"nearest", true}, {"joints_reported", reported}, {"joints_on_person", on}, {"joints", joints}});
+    }
+    f["skeletons"] = ps;
+    if (!o.json)
+      std::printf("%s: %zu people%s\n", folder->file(i).c_str(), people.size(),
+                  people.empty() ? "" : (", the nearest's joints on the person " + std::to_string(ps[nearest]["joints_on_person"].get<std::size_t>()) +
+                                         " of " + std::to_string(ps[nearest]["joints_reported"].get<std::size_t>())).c_str());
+    images.push_back(std::move(f));
+  }
+  nlohmann::json spread = nlohmann::json::object();
+  for (const auto& [name, v] : bones) {
+    double mean = 0, sq = 0;
+    for (double x : v) mean += x;
+    mean /= static_cast<double>(v.size());
+    for (double x : v) sq += (x - mean) * (x - mean);
+    const double sd = v.size() > 1 ? std::sqrt(sq / static_cast<double>(v.size() - 1)) : 0.0;
+    spread[name] = {{"images", v.size()}, {"mean_m", mean}, {"sd_m", sd}};
+    if (!o.json) std::printf("  %-28s %2zu images, mean %.3f m, sd %.3f m\n", name.c_str(), v.size(), mean, sd);
+  }
+  nlohmann::json out{{"directory", o.dir},      {"images", folder->size()},        {"with_one_person", with_one},
+                     {"with_a_person", with_any},
+                     {"nearest_joints_reported", joints_reported}, {"nearest_joints_on_person", joints_on}, {"bones", spread},
+                     {"files", images}};
+  if (o.json) std::printf("%s\n", out.dump(2).c_str());
+  else
+    std::printf("%zu of %zu images with a person (%zu with only one); the nearest person's joints on the person: %zu of %zu\n",
+                with_any, folder->size(), with_one, joints_on, joints_reported);
+  return bad.exit_code(0, folder->size());
+}
+
 void add_files_options(CLI::App* c, DepthOpts& o) {
   c->add_option("directory", o.dir, "the folder of depth images (every file but .txt/.yaml/.json, in name order)")
       ->required()
@@ -127,6 +239,16 @@ void add_depth_command(CLI::App& app, GlobalOptions& g, Action& run) {
   in->add_flag("--json", o->json, "machine-readable output");
   in->callback([o, &run] { run = [o] { return info(*o); }; });
 
+  auto* tr = d->add_subcommand("track", "Run the depth tracker over a folder offline: the people in each image, whether "
+                                         "each joint lies on the person, and each bone's spread over the images");
+  add_files_options(tr, *o);
+  tr->add_option("--sensor-height", o->sensor_height, "the sensor's height above the floor, level (default 1.2 m)")
+      ->check(kPositive);
+  tr->add_option("--on-person", o->on_person_m, "a joint this far in front of the surface at its pixel is off the person (m)")
+      ->check(kPositive);
+  tr->add_flag("--each-alone", o->each_alone, "the images are snapshots, not a recording: track each from scratch");
+  tr->add_flag("--json", o->json, "per image and per bone, as JSON");
+  tr->callback([o, &run] { run = [o] { return track(*o); }; });
   auto* pl = d->add_subcommand("play", "Play a folder of depth images on skelgraph/depth (the depth_files component)");
   add_files_options(pl, *o);
   pl->add_option("--speed", o->speed, "1 as the times say, 2 twice as fast, 0 as fast as possible")->check(kNonNegative);

@@ -381,14 +381,26 @@ std::vector<PersonPoints> find_people(const depth::DepthImage& image, const Eige
     Vector3d sum = Vector3d::Zero();
     for (const auto& p : pts) sum += p.cast<double>();
     const Vector3d centre = sum / static_cast<double>(pts.size());
-    parts.push_back({std::move(pts), centre, 0.0});
+    bool cut = false;  // on the last two rows of the image
+    for (int v = std::max(0, h - 2); v < h && !cut; ++v)
+      for (int u = 0; u < w && !cut; ++u) cut = rm[static_cast<std::size_t>(v) * w + u] != 0;
+    parts.push_back({std::move(pts), centre, 0.0, cut});
   }
-  // Largest first (segment() sorts regions by size): each part joins the first group standing within 0.45 m.
+  // Largest first (segment() sorts regions by size): each part joins the first group standing within 0.45 m;
+  // in a close view cut off below, a part touching a group (points within 10 cm: an arm held out in front
+  // of the trunk, split from it by the depth step) joins it too.
+  const auto touching = [](const Candidate& a, const Candidate& b) {
+    for (const auto& p : a.points)
+      for (const auto& q : b.points)
+        if ((p - q).squaredNorm() < 0.01f) return true;
+    return false;
+  };
   std::vector<Candidate> groups;
   for (auto& part : parts) {
     Candidate* home = nullptr;
     for (auto& g : groups) {
-      if (std::hypot(g.centre.x() - part.centre.x(), g.centre.z() - part.centre.z()) < 0.45) {
+      if (std::hypot(g.centre.x() - part.centre.x(), g.centre.z() - part.centre.z()) < 0.45 ||
+          (part.cut_at_bottom && g.cut_at_bottom && touching(part, g))) {
         home = &g;
         break;
       }
@@ -399,6 +411,7 @@ std::vector<PersonPoints> find_people(const depth::DepthImage& image, const Eige
     }
     const double n0 = static_cast<double>(home->points.size()), n1 = static_cast<double>(part.points.size());
     home->centre = (home->centre * n0 + part.centre * n1) / (n0 + n1);
+    home->cut_at_bottom = home->cut_at_bottom || part.cut_at_bottom;
     home->points.insert(home->points.end(), part.points.begin(), part.points.end());
   }
   std::vector<Candidate> found;
@@ -415,7 +428,8 @@ std::vector<PersonPoints> find_people(const depth::DepthImage& image, const Eige
     g.top = ys[static_cast<std::size_t>(k)];
     const double width = std::hypot(box.sizes().x(), box.sizes().z());
     if (g.top < opt.min_height_m || g.top > opt.max_height_m || width > opt.max_width_m) continue;
-    if (box.sizes().y() < opt.min_extent_m) continue;  // an arm, a box: not a whole person
+    // An arm, a box: not a whole person; unless the image cut it off below (a close, upper-body view).
+    if (box.sizes().y() < (g.cut_at_bottom ? opt.min_upper_extent_m : opt.min_extent_m)) continue;
     if ((g.centre - t).norm() > opt.max_distance_m) continue;
     // Flat: a piece of wall between shadows, not a body.
     Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
@@ -568,7 +582,13 @@ std::vector<skeleton::Skeleton> DepthTracker::track(const depth::DepthImage& ima
     s.sensor_id = image.sensor_id;
     s.frame_id = image.sensor_id;
     s.frame_number = image.frame_number;
-    for (auto& j : s.joints) j.position = sensor_from_world * j.position;
+    for (auto& j : s.joints) {
+      j.position = sensor_from_world * j.position;
+      // Outside the image (legs below a close view's lower edge): not seen at all.
+      const auto px = depth::project(image.intrinsics, j.position);
+      if (j.position.z() <= 0 || px.x() < 0 || px.y() < 0 || px.x() >= image.width() || px.y() >= image.height())
+        j.confidence = skeleton::kLost;
+    }
   }
   return out;
 }

@@ -15,7 +15,8 @@
 // template facing the sensor, scaled to the height of their region; a person
 // not seen for `lost_after_s` is dropped and starts again when found.
 // Per-joint confidence: 1 when enough points support the joint's segments,
-// 0.5 (inferred) when not; the sided joints (shoulders, arms, legs) are
+// 0.5 (inferred) when not, 0 when it lies outside the image (a close,
+// upper-body view: the legs below its lower edge); the sided joints (shoulders, arms, legs) are
 // reported at confidence 0 whenever the person is seen side-on, where front
 // and back (and so left and right) cannot be told apart: fusion then takes
 // them from a sensor that can tell.
@@ -54,6 +55,7 @@ struct TrackerOptions {
   double max_step_m = 0.08;        // neighbouring pixels further apart in depth belong to different regions
   double min_height_m = 0.9, max_height_m = 2.4;  // a person's region: top above the floor
   double min_extent_m = 0.8;       // ... and vertical extent (legs may be out of view)
+  double min_upper_extent_m = 0.4; // ... for a region cut off by the image's lower edge (a close, upper-body view)
   double min_thickness_m = 0.015;  // ... and not flat: spread across its flattest direction (sd)
   double max_distance_m = 5.0;     // ... and this close to the sensor (Kinect-class trackers reach ~4 m)
   double max_width_m = 2.2;        // ... and horizontal extent (arms spread: about the height)
@@ -87,6 +89,7 @@ struct PersonPoints {
   depth::Points points;
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   double top = 0.0;  // height of its top above the floor, m
+  bool cut_at_bottom = false;  // reaches the image's lower edge: the legs are out of view
 };
 // The people in a depth image (step 1 above), without fitting anyone: for
 // point clouds of people and for tests. Throws std::invalid_argument for a malformed image.
