@@ -153,7 +153,8 @@ Classifier one_state(const std::vector<Clip>& clips, const ClassMap& map) {
 // segment the spotter tries is pointing, so the tests below see exactly
 // when the spotter tries (the classifier is not what they are about).
 
-Classifier always_point() {
+// A classifier of one class that never rejects: every segment is that class.
+Classifier always(const std::string& label) {
   std::vector<Clip> clips;
   for (int i = 0; i < 4; ++i) {
     Clip c;
@@ -162,11 +163,12 @@ Classifier always_point() {
     clips.push_back(c);
   }
   ClassMap map;
-  map.classes = {"point"};
+  map.classes = {label};
   Classifier c = one_state(clips, map);
   c.set_threshold(-1e300);
   return c;
 }
+Classifier always_point() { return always("point"); }
 
 // A person at the origin facing +z, arms straight, the left one hanging; the
 // right one raised forward by raise(t) degrees from hanging, at 30 Hz from
@@ -274,17 +276,7 @@ TEST(Spotting, AConfirmationDropsPointingHeldBriefly) {
 // A held gesture other than pointing (a raised palm: "stop") goes out once
 // held `hold` s, without a ray, not when the arm comes down.
 TEST(Spotting, AHeldStopGoesOutWhileTheArmIsStillUp) {
-  std::vector<Clip> clips;
-  for (int i = 0; i < 4; ++i) {
-    Clip c;
-    c.label = 0;
-    c.x = Sequence::Random(30, 8);
-    clips.push_back(c);
-  }
-  ClassMap map;
-  map.classes = {"stop"};
-  Classifier c = one_state(clips, map);
-  c.set_threshold(-1e300);
+  const Classifier c = always("stop");
   // The arm up at 90 degrees from 2.0 to 2.5 s, held until 5.5 s, down by 6 s.
   const auto held = [](double t) {
     return 90.0 * (std::clamp((t - 2.0) / 0.5, 0.0, 1.0) - std::clamp((t - 5.5) / 0.5, 0.0, 1.0));
