@@ -547,3 +547,28 @@ TEST(Nearest, DtwForgivesSpeedNotShape) {
   EXPECT_GT(dtw_distance(a, other, 0.2), 10 * dtw_distance(a, slow, 0.2));
   EXPECT_TRUE(std::isinf(dtw_distance(a, Sequence(0, 2), 0.2)));
 }
+
+// The split by body size: the subjects with the shorter arms form one fold,
+// those with the longer the other, every clip of a subject in its half.
+TEST(CrossValidation, TheSizeSplitCutsTheSubjectsByArmLength) {
+  auto clips = synthetic_clips(10, 7);  // subjects s0..s4
+  const std::map<std::string, double> arm{{"s0", 0.62}, {"s1", 0.55}, {"s2", 0.66}, {"s3", 0.58}, {"s4", 0.60}};
+  for (auto& c : clips) c.arm_length_m = arm.at(c.subject) + (c.label == 1 ? 0.01 : 0.0);
+  CvOptions cv;
+  cv.split = Split::BodySize;
+  const auto results = cross_validate(clips, three_classes(), small_options(), cv);
+  ASSERT_EQ(results.size(), clips.size());
+  std::map<std::string, std::set<int>> folds;
+  for (const auto& r : results) folds[clips[r.clip].subject].insert(r.fold);
+  for (const auto& [s, f] : folds) ASSERT_EQ(f.size(), 1u) << s;
+  // The shorter half (of 5 subjects, the middle one goes with the shorter: s1 0.55, s3 0.58, s4 0.60) in fold 0.
+  EXPECT_EQ(*folds["s1"].begin(), 0);
+  EXPECT_EQ(*folds["s3"].begin(), 0);
+  EXPECT_EQ(*folds["s4"].begin(), 0);
+  EXPECT_EQ(*folds["s0"].begin(), 1);
+  EXPECT_EQ(*folds["s2"].begin(), 1);
+  // A subject never measured (no arm joints in any clip): a clear error.
+  for (auto& c : clips)
+    if (c.subject == "s2") c.arm_length_m = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(cross_validate(clips, three_classes(), small_options(), cv), ModelError);
+}

@@ -183,7 +183,7 @@ struct CvRun {
 
 CvOptions cv_options(const GestureOptions& o) {
   CvOptions cv;
-  cv.split = o.split == "kfold" ? Split::KFold : Split::LeaveSubjectOut;
+  cv.split = o.split == "kfold" ? Split::KFold : o.split == "size" ? Split::BodySize : Split::LeaveSubjectOut;
   cv.folds = o.folds;
   cv.seed = o.seed;
   return cv;
@@ -438,19 +438,28 @@ int gesture_cv(const GestureOptions& o) {
     nested_metrics = evaluate(nested->results, map.classes);
   }
   const auto& win = runs[best];
-  const std::string split = o.split == "kfold" ? std::to_string(o.folds) + "-fold stratified" : "leave-subject-out";
+  const std::string split = o.split == "kfold" ? std::to_string(o.folds) + "-fold stratified"
+                            : o.split == "size" ? "by body size (shorter arms vs longer, both ways)"
+                                                : "leave-subject-out";
   if (!o.svg.empty()) {
     std::ofstream f(o.svg);
     f << confusion_svg(win.metrics, split + ", " + o.classes);
     if (!f) throw std::runtime_error("cannot write " + o.svg);
   }
   if (o.json) {
-    nlohmann::json j{{"split", o.split == "kfold" ? "kfold" : "leave-subject-out"},
+    nlohmann::json j{{"split", o.split == "kfold" ? "kfold" : o.split == "size" ? "size" : "leave-subject-out"},
                      {"folds", o.split == "kfold" ? o.folds : -1},
                      {"clips", clips.size()},
                      {"classes", map.to_json()},
                      {"config", config_json(win.config)},
                      {"metrics", to_json(win.metrics)}};
+    if (o.split == "size") {  // what the halves were cut by
+      std::map<std::string, std::vector<double>> arms;
+      for (const auto& c : clips)
+        if (std::isfinite(c.arm_length_m)) arms[c.subject].push_back(c.arm_length_m);
+      auto& by = j["arm_length_m_by_subject"] = nlohmann::json::object();
+      for (const auto& [subject, v] : arms) by[subject] = stats::median(v);
+    }
     auto& per = j["clips"] = nlohmann::json::array();
     for (const auto& r : win.results) {
       const auto& clip = clips[r.clip];
@@ -890,8 +899,10 @@ void add_gesture_command(CLI::App& app, GlobalOptions&, Action& run) {
   cv->add_flag("--nearest", o->nearest,
                "an experiment: each clip takes the class of its nearest training clip by dynamic time warping (the "
                "features and --hands as given; the HMM options unused); cross-validation only");
-  cv->add_option("--split", o->split, "lso: leave one subject out (default); kfold: stratified k-fold")
-      ->check(CLI::IsMember({"lso", "kfold"}));
+  cv->add_option("--split", o->split,
+                 "lso: leave one subject out (default); kfold: stratified k-fold; size: the subjects with the shorter "
+                 "arms against those with the longer (trained on one half, tested on the other, both ways)")
+      ->check(CLI::IsMember({"lso", "kfold", "size"}));
   cv->add_option("--folds", o->folds, "k for --split kfold (default 5)")->check(CLI::Range(2, 1000));
   cv->add_option("--svg", o->svg, "write the confusion matrix as SVG");
   cv->add_flag("--sweep", o->sweep, "try every states x mixtures x covariance (x initialisation) combination and report the best");

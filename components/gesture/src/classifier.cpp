@@ -1,5 +1,6 @@
 #include "skelgraph/gesture/classifier.hpp"
 #include "skelgraph/skeleton/json_number.hpp"
+#include "skelgraph/skeleton/stats.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -427,6 +428,24 @@ namespace {
 std::vector<int> assign_folds(const std::vector<Clip>& clips, const CvOptions& cv, int* folds_out) {
   std::vector<int> fold(clips.size(), 0);
   int folds = 0;
+  if (cv.split == Split::BodySize) {
+    std::map<std::string, std::vector<double>> arms;
+    for (const auto& c : clips)
+      if (std::isfinite(c.arm_length_m)) arms[c.subject].push_back(c.arm_length_m);
+    std::vector<std::pair<double, std::string>> by_size;
+    for (const auto& c : clips) arms.emplace(c.subject, std::vector<double>{});
+    for (auto& [s, v] : arms) {
+      if (v.empty()) throw ModelError("size split: subject '" + s + "' has no clip with both arms' joints to measure");
+      by_size.emplace_back(stats::median(v), s);
+    }
+    if (by_size.size() < 2) throw ModelError("the size split needs clips of at least 2 subjects");
+    std::sort(by_size.begin(), by_size.end());
+    std::map<std::string, int> half;
+    for (std::size_t i = 0; i < by_size.size(); ++i) half[by_size[i].second] = 2 * i < by_size.size() ? 0 : 1;
+    for (std::size_t i = 0; i < clips.size(); ++i) fold[i] = half[clips[i].subject];
+    *folds_out = 2;
+    return fold;
+  }
   if (cv.split == Split::LeaveSubjectOut) {
     std::map<std::string, int> subjects;
     for (const auto& c : clips) subjects.emplace(c.subject, 0);

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <tuple>
+
+#include "skelgraph/skeleton/stats.hpp"
 
 namespace skelgraph::gesture {
 
@@ -67,6 +70,14 @@ Clip load_clip(const std::string& file, const ClassMap& map, const DatasetOption
     throw playback::DataError(file, rec.report.last_line, "one skeleton frame only: a clip needs at least 2");
   c.label = map.label_of(c.action).value_or(-1);
   c.x = clip_features(rec, o);
+  // Arm length: shoulder-elbow-hand of either arm, median over the frames where all three are seen.
+  std::vector<double> arms;
+  using J = skeleton::JointId;
+  for (const auto& f : rec.frames)
+    for (const auto& [s, e, h] : {std::tuple{J::LeftShoulder, J::LeftElbow, J::LeftHand}, std::tuple{J::RightShoulder, J::RightElbow, J::RightHand}})
+      if (f[s].confidence > 0 && f[e].confidence > 0 && f[h].confidence > 0)
+        arms.push_back((f[s].position - f[e].position).norm() + (f[e].position - f[h].position).norm());
+  if (!arms.empty()) c.arm_length_m = stats::median(arms);
   return c;
 }
 }  // namespace

@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
@@ -50,6 +51,7 @@ struct Clip {
   std::string action;   // as recorded
   int label = -1;       // class index, -1: not in any class (a rejection test input)
   Sequence x;
+  double arm_length_m = std::numeric_limits<double>::quiet_NaN();  // shoulder-elbow-hand, median over the clip (the size split)
 };
 
 // Either hand may perform a gesture. Canonical: every clip (in training and
@@ -182,7 +184,10 @@ nlohmann::json to_json(const Metrics& m);
 std::string confusion_text(const Metrics& m);
 std::string confusion_svg(const Metrics& m, const std::string& title);
 
-enum class Split { KFold, LeaveSubjectOut };
+// Body size: the subjects sorted by arm length (the median of their clips')
+// and cut in two halves; two folds: trained on the longer arms and tested on
+// the shorter, and the reverse.
+enum class Split { KFold, LeaveSubjectOut, BodySize };
 
 struct CvOptions {
   Split split = Split::LeaveSubjectOut;
