@@ -92,7 +92,7 @@ PY
 ok "depth track on skeltrack-depth: $(json_get "$WORK/track.json" 'd["with_a_person"]') of 12 images with the person, $(json_get "$WORK/track.json" 'd["nearest_joints_on_person"]') of $(json_get "$WORK/track.json" 'd["nearest_joints_reported"]') joints on the person"
 
 # ... and through fusion from the launch file (its pose assumed level: bringup/calib/depth_level.yaml).
-"$S" launch "$SRC/bringup/depth_files.yaml" --set viewer.port=0 --duration 8 --json >"$WORK/launch.json" 2>"$WORK/launch.err" ||
+"$S" launch "$SRC/bringup/depth_files.yaml" --set viewer.port=0 --duration 5 --json >"$WORK/launch.json" 2>"$WORK/launch.err" ||
   fail "depth_files.yaml: $(tail -3 "$WORK/launch.err")"
 json_check "$WORK/launch.json" '[c for c in d["components"] if c["name"] == "depth_tracker"][0]["details"]["sensors"]["depth1"]["skeletons"] > 0'
 python3 - "$WORK/launch.json" <<'PY' || fail "no fused skeleton from the real images: $(grep -h 'fusion' "$WORK/launch.err" | tail -2)"

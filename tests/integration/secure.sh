@@ -95,7 +95,7 @@ grep -q "could not create a writer on skelgraph/sync (security: the permissions 
   "$WORK/reader.sync" || fail "reader1's refusal: $(tail -3 "$WORK/reader.sync")"
 # The robot's commands: a stranger finds no robot to talk to, the read-only host may not
 # write a command, the robot-control host stops it.
-if on sensor2 "$SKELGRAPH" robot stop --timeout 5 --profile lan --interface "$(addr sensor2)" >"$WORK/stranger.robot" 2>&1; then
+if on sensor2 "$SKELGRAPH" robot stop --timeout 3 --profile lan --interface "$(addr sensor2)" >"$WORK/stranger.robot" 2>&1; then
   fail "a stranger's robot stop was taken: $(cat "$WORK/stranger.robot")"
 fi
 grep -q "no state of a robot" "$WORK/stranger.robot" || fail "stranger: $(tail -2 "$WORK/stranger.robot")"
