@@ -65,7 +65,7 @@ for h in reader1 fusion; do
 done
 if "$SKELGRAPH" robot stop --timeout 3 >"$WORK/stranger.robot" 2>&1; then fail "a stranger's robot stop was acknowledged"; fi
 grep -q "no state of a robot" "$WORK/stranger.robot" || fail "stranger: $(cat "$WORK/stranger.robot")"
-if SKELGRAPH_HOST=control "$SKELGRAPH" robot stop --security "$WORK/rc" --source mallory --timeout 3 --json \
+if SKELGRAPH_HOST=control "$SKELGRAPH" robot stop --security "$WORK/rc" --source mallory --timeout 6 --json \
   >"$WORK/mallory.json" 2>"$WORK/mallory.err"; then
   fail "the robot took a stop from an unknown source"
 fi
