@@ -65,6 +65,7 @@ struct GestureOptions {
   // sim
   int train_sessions = kTrainSessions, test_sessions = 4;
   double test_noise_scale = 1.0;  // gesture sim: the test sessions' tracker noise
+  double test_height = 1.75;      // gesture sim: the test sessions' people's height
   std::vector<std::string> quiet_scenarios = gesture::quiet_scenarios();  // gesture sim: where nobody gestures
   int quiet_sessions = 1;                                                  // ... sessions of each
   int train_quiet_sessions = kTrainQuietSessions;                          // ... to train against (hard negatives)
@@ -677,7 +678,7 @@ int gesture_sim(const GestureOptions& o) {
                                   o.train_quiet_sessions);
   if (!o.out.empty()) model.save(o.out);
   const auto test = held_out_sessions(o.test_sessions, o.seed, [&](int d, int t) { progress("simulating and fusing test sessions", d, t); },
-                                      o.test_noise_scale);
+                                      o.test_noise_scale, o.test_height);
   const auto spotted = spot_sessions(model, test, o.spot);
   const auto quiet = spot_quiet(model,
                                 quiet_sessions(o.quiet_scenarios, o.quiet_sessions, o.seed,
@@ -735,6 +736,7 @@ int gesture_sim(const GestureOptions& o) {
                                         {"test_sessions", o.test_sessions},
                                         {"seed", o.seed},
                                         {"test_noise_scale", o.test_noise_scale},
+                                        {"test_height_m", o.test_height},
                                         {"clips", clips},
                                         {"config", config_json(c)},
                                         {"model", o.out},
@@ -950,6 +952,9 @@ void add_gesture_command(CLI::App& app, GlobalOptions&, Action& run) {
   add_model_options(sm, *o);
   sm->add_option("--train-sessions", o->train_sessions, "pointing sessions to train on (default 24)")->check(CLI::Range(1, 200));
   sm->add_option("--test-sessions", o->test_sessions, "sessions to spot on (default 4)")->check(CLI::Range(1, 200));
+  sm->add_option("--test-height", o->test_height,
+                 "the test sessions' people's height, m (training: 1.75): how the model does on people of another size")
+      ->check(CLI::Range(1.0, 2.2));
   sm->add_option("--test-noise-scale", o->test_noise_scale,
                  "scale of the trackers' random errors in the test sessions (default 1; 0 leaves the skeleton convention's "
                  "offsets, the lag and the geometry: how far the targets are off without the tracker's noise)")

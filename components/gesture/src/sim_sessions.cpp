@@ -12,10 +12,12 @@ namespace skelgraph::gesture {
 using Eigen::Vector3d;
 using skeleton::JointId;
 
-SimSession simulate_session(std::uint64_t seed, const Surface& floor, double noise_scale, const std::string& scenario) {
+SimSession simulate_session(std::uint64_t seed, const Surface& floor, double noise_scale, const std::string& scenario,
+                            double height_m) {
   sim::SimConfig cfg;
   cfg.scenario.name = scenario;
   cfg.scenario.seed = seed;
+  cfg.scenario.height = height_m;
   cfg.noise_scale = noise_scale;
   sim::Simulation simulation(cfg);
   std::map<std::string, Eigen::Isometry3d> poses;
@@ -220,10 +222,10 @@ std::vector<Clip> session_clips(const std::vector<SimSession>& sessions, const C
 namespace skelgraph::gesture {
 
 std::vector<SimSession> held_out_sessions(int sessions, std::uint64_t seed, const std::function<void(int, int)>& progress,
-                                          double noise_scale) {
+                                          double noise_scale, double height_m) {
   std::vector<SimSession> out;
   for (int i = 0; i < sessions; ++i) {
-    out.push_back(simulate_session((seed + 1) * 1000 + 500 + static_cast<std::uint64_t>(i), {}, noise_scale));
+    out.push_back(simulate_session((seed + 1) * 1000 + 500 + static_cast<std::uint64_t>(i), {}, noise_scale, "point", height_m));
     if (progress) progress(i + 1, sessions);
   }
   return out;

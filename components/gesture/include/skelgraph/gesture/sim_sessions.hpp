@@ -52,7 +52,7 @@ std::vector<double> whole_hold_target_errors(const std::vector<SimSession>& sess
 // trackers' random errors (sim::SimConfig). Scenarios other than point have
 // no true gestures: every event spotted in them is a false alarm.
 SimSession simulate_session(std::uint64_t seed, const Surface& floor = {}, double noise_scale = 1.0,
-                            const std::string& scenario = "point");
+                            const std::string& scenario = "point", double height_m = 1.75);
 
 // The simulator's scenarios in which nobody gestures, what a worker does
 // besides: walk, 360, hide, box, occ, sit, arms, and work (a bench beside a
@@ -97,9 +97,10 @@ ClassMap sim_class_map();
 ClassifierOptions sim_classifier_options();
 
 // Sessions the training never sees (seeds (seed + 1) * 1000 + 500 + i).
+// `height_m`: the people's height (the training sessions' is 1.75 m).
 std::vector<SimSession> held_out_sessions(int sessions, std::uint64_t seed,
                                           const std::function<void(int done, int total)>& progress = {},
-                                          double noise_scale = 1.0);
+                                          double noise_scale = 1.0, double height_m = 1.75);
 
 // Each session spotted (one Spotter per fused person) and scored against its own truth.
 struct SessionSpotting {
