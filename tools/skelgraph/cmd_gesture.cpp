@@ -66,6 +66,7 @@ struct GestureOptions {
   int train_sessions = kTrainSessions, test_sessions = 4;
   double test_noise_scale = 1.0;  // gesture sim: the test sessions' tracker noise
   double test_height = 1.75;      // gesture sim: the test sessions' people's height
+  std::vector<double> train_heights{1.75};  // gesture sim: the training sessions' people's heights, in turn
   std::vector<std::string> quiet_scenarios = gesture::quiet_scenarios();  // gesture sim: where nobody gestures
   int quiet_sessions = 1;                                                  // ... sessions of each
   int train_quiet_sessions = kTrainQuietSessions;                          // ... to train against (hard negatives)
@@ -675,7 +676,7 @@ int gesture_sim(const GestureOptions& o) {
   std::size_t clips = 0;
   const auto model = train_on_sim(o.train_sessions, o.seed, c, &clips,
                                   [&](int d, int t) { progress("simulating and fusing training sessions", d, t); }, o.spot,
-                                  o.train_quiet_sessions);
+                                  o.train_quiet_sessions, o.train_heights);
   if (!o.out.empty()) model.save(o.out);
   const auto test = held_out_sessions(o.test_sessions, o.seed, [&](int d, int t) { progress("simulating and fusing test sessions", d, t); },
                                       o.test_noise_scale, o.test_height);
@@ -737,6 +738,7 @@ int gesture_sim(const GestureOptions& o) {
                                         {"seed", o.seed},
                                         {"test_noise_scale", o.test_noise_scale},
                                         {"test_height_m", o.test_height},
+                                        {"train_heights_m", o.train_heights},
                                         {"clips", clips},
                                         {"config", config_json(c)},
                                         {"model", o.out},
@@ -952,6 +954,10 @@ void add_gesture_command(CLI::App& app, GlobalOptions&, Action& run) {
   add_model_options(sm, *o);
   sm->add_option("--train-sessions", o->train_sessions, "pointing sessions to train on (default 24)")->check(CLI::Range(1, 200));
   sm->add_option("--test-sessions", o->test_sessions, "sessions to spot on (default 4)")->check(CLI::Range(1, 200));
+  sm->add_option("--train-heights", o->train_heights,
+                 "the training sessions' people's heights, m, one session each in turn (default 1.75: the built-in model)")
+      ->delimiter(',')
+      ->check(CLI::Range(1.0, 2.2));
   sm->add_option("--test-height", o->test_height,
                  "the test sessions' people's height, m (training: 1.75): how the model does on people of another size")
       ->check(CLI::Range(1.0, 2.2));

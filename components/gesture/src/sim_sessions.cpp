@@ -312,14 +312,17 @@ ClassifierOptions sim_classifier_options() {
 }
 
 Classifier train_on_sim(int sessions, std::uint64_t seed, const ClassifierOptions& options, std::size_t* clips,
-                        const std::function<void(int, int)>& progress, const SpotterOptions& spot_options, int quiet_per_scenario) {
+                        const std::function<void(int, int)>& progress, const SpotterOptions& spot_options, int quiet_per_scenario,
+                        const std::vector<double>& heights_m) {
+  if (heights_m.empty()) throw ModelError("train_on_sim: no training heights");
   // Training sees every event, however unsure or short: the operating point is the user's, at spotting time.
   SpotterOptions spot = spot_options;
   spot.min_confidence = 0.0;
   spot.confirm = 0.0;
   std::vector<SimSession> train;
   for (int i = 0; i < sessions; ++i) {
-    train.push_back(simulate_session(seed * 1000 + static_cast<std::uint64_t>(i)));
+    train.push_back(simulate_session(seed * 1000 + static_cast<std::uint64_t>(i), {}, 1.0, "point",
+                                     heights_m[static_cast<std::size_t>(i) % heights_m.size()]));
     if (progress) progress(i + 1, sessions);
   }
   const auto map = sim_class_map();

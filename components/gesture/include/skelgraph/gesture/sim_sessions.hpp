@@ -121,8 +121,10 @@ constexpr int kTrainQuietSessions = 8;
 // quiet_per_scenario > 0, what a first model spots in that many training
 // sessions of each quiet scenario is added as "other" and it is trained again.
 // The pointing correction is learnt by spotting the training sessions with `spot`.
+// `heights_m`: the training people's heights, session i the (i mod n)-th
+// (default: everyone 1.75 m, as the built-in model is trained).
 Classifier train_on_sim(int sessions, std::uint64_t seed, const ClassifierOptions& options, std::size_t* clips = nullptr,
                         const std::function<void(int done, int total)>& progress = {}, const SpotterOptions& spot = sim_spotter_options(),
-                        int quiet_per_scenario = kTrainQuietSessions);
+                        int quiet_per_scenario = kTrainQuietSessions, const std::vector<double>& heights_m = {1.75});
 
 }  // namespace skelgraph::gesture
