@@ -1,5 +1,8 @@
 #include "skelgraph/eval/fetch.hpp"
 
+#include <filesystem>
+
+#include "skelgraph/gesture/builtin_models.hpp"
 #include "skelgraph/gesture/sim_sessions.hpp"
 #include "skelgraph/robot/arm.hpp"
 
@@ -7,7 +10,9 @@ namespace skelgraph::eval {
 
 FetchRunResult run_fetch(const FetchRunOptions& o) {
   using namespace skelgraph::gesture;
-  const auto model = train_on_sim(o.train_sessions, o.seed, sim_classifier_options());
+  // With the build's training set-up the model is the built-in one: loaded, not trained again.
+  const bool builtin = o.train_sessions == kTrainSessions && o.seed == 1 && std::filesystem::exists(builtin_model_path("sim"));
+  const auto model = builtin ? load_builtin_model("sim") : train_on_sim(o.train_sessions, o.seed, sim_classifier_options());
   const auto sessions = held_out_sessions(o.sessions, o.seed);
   const auto spotted = spot_sessions(model, sessions);
   const Eigen::Vector3d base = o.world_from_base.translation();
