@@ -242,3 +242,19 @@ TEST(DepthTracker, FitsKeepTheJointLimitsThatTheTruthKeeps) {
     EXPECT_LE(20 * on[1], off[1]) << scenario;
   }
 }
+
+// The check `skelgraph depth track` uses on real depth: a joint is on the
+// person when its pixel has a reading and it is not in front of that surface.
+TEST(DepthTracker, AJointIsOnTheSurfaceItsPixelShows) {
+  auto img = depth::DepthImage::blank(depth::kinect_intrinsics(64, 48));
+  for (int v = 10; v < 30; ++v)
+    for (int u = 20; u < 40; ++u) img.mm[static_cast<std::size_t>(v) * 64 + u] = 1500;  // a patch 1.5 m away
+  const Eigen::Vector3d centre = depth::unproject(img.intrinsics, 30, 20, 1.5);
+  EXPECT_TRUE(depth_tracker::on_surface(img, centre));
+  EXPECT_TRUE(depth_tracker::on_surface(img, centre * (1.6 / 1.5)));   // behind the surface: inside the body
+  EXPECT_TRUE(depth_tracker::on_surface(img, centre * (1.46 / 1.5)));  // 4 cm in front: within the margin
+  EXPECT_FALSE(depth_tracker::on_surface(img, centre * (1.3 / 1.5)));  // 20 cm in front: in the air
+  EXPECT_FALSE(depth_tracker::on_surface(img, depth::unproject(img.intrinsics, 5, 5, 1.5)));    // a pixel without a reading
+  EXPECT_FALSE(depth_tracker::on_surface(img, depth::unproject(img.intrinsics, -20, 20, 1.5)));  // outside the image
+  EXPECT_FALSE(depth_tracker::on_surface(img, Eigen::Vector3d(0, 0, -1)));                      // behind the sensor
+}

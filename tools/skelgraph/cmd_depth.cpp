@@ -159,12 +159,7 @@ int track(const DepthOpts& o) {
         if (jt.confidence <= 0) continue;
         ++reported;
         const auto px = depth::project(img.intrinsics, jt.position);
-        const int u = static_cast<int>(std::lround(px.x())), v = static_cast<int>(std::lround(px.y()));
-        bool on_person = false;
-        if (u >= 0 && v >= 0 && u < img.width() && v < img.height()) {
-          const auto mm = img.mm[static_cast<std::size_t>(v) * static_cast<std::size_t>(img.width()) + static_cast<std::size_t>(u)];
-          on_person = mm > 0 && jt.position.z() >= mm * 1e-3 - o.on_person_m;
-        }
+        const bool on_person = depth_tracker::on_surface(img, jt.position, o.on_person_m);
         on += on_person;
         joints[skeleton::joint_name(skeleton::joint_at(j))] = {
             {"pixel", {px.x(), px.y()}}, {"confidence", jt.confidence}, {"on_person", on_person}};

@@ -572,6 +572,15 @@ std::vector<skeleton::Skeleton> DepthTracker::Impl::step(std::vector<PersonPoint
   return out;
 }
 
+bool on_surface(const depth::DepthImage& image, const Eigen::Vector3d& joint, double margin_m) {
+  if (joint.z() <= 0) return false;
+  const auto px = depth::project(image.intrinsics, joint);
+  const long u = std::lround(px.x()), v = std::lround(px.y());
+  if (u < 0 || v < 0 || u >= image.width() || v >= image.height()) return false;
+  const auto mm = image.mm[static_cast<std::size_t>(v) * static_cast<std::size_t>(image.width()) + static_cast<std::size_t>(u)];
+  return mm > 0 && joint.z() >= mm * 1e-3 - margin_m;
+}
+
 std::vector<skeleton::Skeleton> DepthTracker::track(const depth::DepthImage& image) {
   depth::check(image);
   auto& d = *impl_;

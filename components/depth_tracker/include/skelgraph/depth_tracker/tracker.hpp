@@ -96,6 +96,12 @@ struct PersonPoints {
 std::vector<PersonPoints> find_people(const depth::DepthImage& image, const Eigen::Isometry3d& world_from_sensor,
                                       const TrackerOptions& options = {});
 
+// Whether a joint (sensor frame) lies on what the image shows: its pixel has
+// a reading and the joint is no more than `margin_m` in front of that
+// surface (behind it is fine: joints are inside the body). For checking a
+// tracker on real depth without ground truth (`skelgraph depth track`).
+bool on_surface(const depth::DepthImage& image, const Eigen::Vector3d& joint, double margin_m = 0.05);
+
 class DepthTracker {
  public:
   explicit DepthTracker(TrackerOptions options = {});
