@@ -1,22 +1,23 @@
 #!/usr/bin/env bash
 # The depth path end to end (bringup/depth_sim.yaml): the simulator's depth
 # images of two sensors -> the open depth tracker -> kalman fusion -> gesture
-# spotting, and the merged point cloud for viewers. Checks rates on every
-# stage, one person (no ghosts from walls), pointing events with floor
+# spotting, and the merged point cloud for viewers. Checks that every
+# stage delivers, one person (no ghosts from walls), pointing events with floor
 # targets, the cloud where the person is, and a tracker that waits for poses.
 source "$(dirname "$0")/lib.sh"
 
-"$SKELGRAPH" launch bringup/depth_sim.yaml --duration 32 --json >"$WORK/launch.json" 2>"$WORK/launch.err" &
+"$SKELGRAPH" launch bringup/depth_sim.yaml --duration 60 --json >"$WORK/launch.json" 2>"$WORK/launch.err" &
 graph=$!
-"$SKELGRAPH" topic echo skelgraph/gesture/event --json --timeout 40 >"$WORK/events.jsonl" 2>/dev/null &
+# Two pointing events are what the checks below need: stop the graph once they are out.
+"$SKELGRAPH" topic echo skelgraph/gesture/event --json --count 2 --timeout 55 >"$WORK/events.jsonl" 2>/dev/null &
 echo_pid=$!
-sleep 6
-"$SKELGRAPH" topic echo skelgraph/cloud --count 1 --json --timeout 10 >"$WORK/cloud.json" || fail "no cloud"
+"$SKELGRAPH" topic echo skelgraph/cloud --count 1 --json --timeout 20 >"$WORK/cloud.json" || fail "no cloud"
 for t in depth skeleton/raw skeleton/fused; do
   "$SKELGRAPH" topic hz "skelgraph/$t" --json --window 3 --timeout 10 >"$WORK/hz_${t//\//_}.json" || fail "no skelgraph/$t: $(tail -5 "$WORK/launch.err")"
 done
+wait "$echo_pid" || true
+kill -INT "$graph"
 wait "$graph" || fail "launch: $(tail -5 "$WORK/launch.err")"
-kill "$echo_pid" 2>/dev/null || true
 # Every stage delivers (its rate on a busy machine is the benchmarks' business, not a test's).
 for t in depth skeleton_raw skeleton_fused; do json_check "$WORK/hz_$t.json" 'd["samples"] >= 10'; done
 python3 - "$WORK/launch.json" "$WORK/events.jsonl" <<'PY' || fail "graph report: $(cat "$WORK/launch.json")"
@@ -25,11 +26,11 @@ rep = {c["name"]: c for c in json.load(open(sys.argv[1]))["components"]}
 for name in ("sim", "depth_tracker", "fusion", "gesture", "cloud"):
     assert rep[name]["state"] == "OK", (name, rep[name]["state"], rep[name].get("message"))
 sim = rep["sim"]["details"]
-assert sim["raw_published"] == 0 and sim["depth_published"] > 1500, sim
+assert sim["raw_published"] == 0 and sim["depth_published"] > 300, sim
 trk = rep["depth_tracker"]["details"]["sensors"]
 for s in ("sensor1", "sensor2"):
     t = trk[s]
-    assert t["images"] > 300 and t["skeletons"] >= 0.95 * t["images"], (s, t)   # the person in nearly every image
+    assert t["images"] > 100 and t["skeletons"] >= 0.95 * t["images"], (s, t)   # the person in nearly every image
     assert t["skeletons"] <= t["images"], (s, t)                              # and nobody else
     assert t["people_started"] <= 2, (s, t)
 events = [json.loads(l)["data"] for l in open(sys.argv[2]) if l.strip()]
@@ -45,22 +46,22 @@ json_check "$WORK/cloud.json" 'd["data"]["source"] == "merged" and d["data"]["fr
 ok "depth -> tracker -> fusion -> gesture; merged cloud of $(json_get "$WORK/cloud.json" 'd["data"]["points"]') points"
 
 # Merged views: one tracker fitting both sensors' points, published as sensor "merged" in the world frame.
-"$SKELGRAPH" run sim -p depth=true -p publish_raw=false -p scenario=point -p loop=true --duration 12 >/dev/null 2>"$WORK/sim3.err" &
+"$SKELGRAPH" run sim -p depth=true -p publish_raw=false -p scenario=point -p loop=true --duration 8 >/dev/null 2>"$WORK/sim3.err" &
 sim3=$!
-"$SKELGRAPH" run depth_tracker -p merge=true --duration 10 --json >"$WORK/merged.json" 2>"$WORK/merged.err" &
+"$SKELGRAPH" run depth_tracker -p merge=true --duration 6 --json >"$WORK/merged.json" 2>"$WORK/merged.err" &
 merged=$!
 "$SKELGRAPH" topic echo skelgraph/skeleton/raw --count 1 --json --timeout 10 >"$WORK/merged_raw.json" || fail "no merged skeleton: $(cat "$WORK/merged.err")"
 wait "$merged" || fail "merged tracker: $(cat "$WORK/merged.err")"
 wait "$sim3" || true
 json_check "$WORK/merged_raw.json" 'd["data"]["sensor_id"] == "merged" and d["data"]["frame_id"] == "world"'
-json_check "$WORK/merged.json" 'd["components"][0]["state"] == "OK" and d["components"][0]["details"]["merged"]["fits"] > 200 and d["components"][0]["details"]["merged"]["skeletons"] >= 0.95 * d["components"][0]["details"]["merged"]["fits"] and d["components"][0]["details"]["merged"]["skeletons"] <= d["components"][0]["details"]["merged"]["fits"]'
+json_check "$WORK/merged.json" 'd["components"][0]["state"] == "OK" and d["components"][0]["details"]["merged"]["fits"] > 80 and d["components"][0]["details"]["merged"]["skeletons"] >= 0.95 * d["components"][0]["details"]["merged"]["fits"] and d["components"][0]["details"]["merged"]["skeletons"] <= d["components"][0]["details"]["merged"]["fits"]'
 ok "merged views: $(json_get "$WORK/merged.json" 'd["components"][0]["summary"]')"
 
 # Without poses (publish_poses off, no calibration) the tracker waits and says so.
 "$SKELGRAPH" run sim -p depth=true -p publish_raw=false -p publish_poses=false -p sensor_count=1 -p loop=true \
-  --duration 6 >/dev/null 2>"$WORK/sim2.err" &
+  --duration 5 >/dev/null 2>"$WORK/sim2.err" &
 sim2=$!
-"$SKELGRAPH" run depth_tracker --duration 5 --json >"$WORK/waiting.json" 2>"$WORK/waiting.err" || fail "tracker: $(cat "$WORK/waiting.err")"
+"$SKELGRAPH" run depth_tracker --duration 4 --json >"$WORK/waiting.json" 2>"$WORK/waiting.err" || fail "tracker: $(cat "$WORK/waiting.err")"
 wait "$sim2" || true
 json_check "$WORK/waiting.json" 'd["components"][0]["state"] == "DEGRADED" and "waiting for the pose of sensor1" in d["components"][0]["message"] and d["components"][0]["details"]["sensors"]["sensor1"]["skeletons"] == 0'
 ok "no pose: tracker waits and says why"
