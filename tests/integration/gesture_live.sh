@@ -13,8 +13,12 @@ echo_pid=$!
 # Every state the component publishes (on each change and once a second), until the launch ends.
 "$S" topic echo skelgraph/gesture/state --json --timeout 60 >"$WORK/states.json" 2>"$WORK/echo_state.err" &
 state_pid=$!
-"$S" launch bringup/gesture_sim.yaml --duration 35 --json >"$WORK/launch.json" 2>"$WORK/launch.err" \
-  || fail "launch: $(tail -5 "$WORK/launch.err")"
+"$S" launch bringup/gesture_sim.yaml --duration 90 --json >"$WORK/launch.json" 2>"$WORK/launch.err" &
+launch=$!
+# Three pointing events in the log are what the checks need: then the graph is stopped.
+wait_for_count "$WORK/launch.err" "point by person 1 (.* arm) at floor" 3 80
+kill -INT "$launch"
+wait "$launch" || fail "launch: $(tail -5 "$WORK/launch.err")"
 wait "$echo_pid" || fail "topic echo saw no gesture events: $(cat "$WORK/echo.err")"
 n=$(grep -c "point by person 1 (.* arm) at floor" "$WORK/launch.err" || true)
 [ "$n" -ge 3 ] || fail "expected at least 3 pointing events with floor targets in the log, got $n: $(grep gesture "$WORK/launch.err" | tail -5)"
@@ -38,8 +42,8 @@ python3 - "$WORK/states.json" "$WORK/events.json" <<'PY' || fail "gesture states
 import json, sys
 states = [json.loads(l).get("data") for l in open(sys.argv[1]) if l.strip()]
 events = [json.loads(l).get("data") for l in open(sys.argv[2]) if l.strip()]
-# 35 s: at least one a second while the person is watched, and more on every change.
-assert len(states) >= 20, len(states)
+# At least one a second while the person is watched, and more on every change.
+assert len(states) >= 10, len(states)
 for s in states:
     assert s["state"] in ("resting", "moving", "holding"), s
     assert s["person_id"] >= 1 and s["source"] and s["stamp_ns"] > 0, s

@@ -32,6 +32,17 @@ wait_for_match() {
   grep -q -- "$pattern" "$file" 2>/dev/null
 }
 
+# wait_for_count FILE PATTERN N SECONDS: waits (bounded, polling) until FILE has N lines matching PATTERN.
+wait_for_count() {
+  local file=$1 pattern=$2 n=$3 deadline=$((SECONDS + $4)) c
+  while :; do
+    c=$(grep -c -- "$pattern" "$file" 2>/dev/null || true)
+    [ "${c:-0}" -ge "$n" ] && return 0
+    [ "$SECONDS" -lt "$deadline" ] || return 1
+    python3 -c 'import time; time.sleep(0.1)'
+  done
+}
+
 # retry N CMD...: runs CMD until it succeeds, at most N times (each try is itself bounded).
 retry() {
   local n=$1; shift
