@@ -35,7 +35,7 @@ player=$!
 json_check "$WORK/st0.json" 'd[0]["paused"] and d[0]["frames"] == 0 and d[0]["frame_count"] == 12'
 "$S" topic echo skelgraph/depth --count 3 --json --timeout 15 >"$WORK/steps.jsonl" 2>"$WORK/steps.err" &
 echo_pid=$!
-sleep 2  # the echo's reader matched
+wait_for_match "$WORK/steps.err" "echo: matched" 10 || fail "the echo found no depth writer: $(cat "$WORK/steps.err")"
 "$S" player step --frames 3 --json >"$WORK/st1.json" || fail "step"
 json_check "$WORK/st1.json" 'd[0]["paused"] and d[0]["frames"] == 3'
 wait "$echo_pid" || fail "echo of the steps: $(cat "$WORK/steps.err")"

@@ -9,24 +9,27 @@ source "$(dirname "$0")/lib.sh"
 # 1. Live, with a sync master: two sessions recorded (the first left unmended on purpose).
 # The launch file as users run it (recordings/oni relative to where it runs: here $WORK), beside a second Dummy
 # device that leaves its recordings unmended.
-(cd "$WORK" && exec "$SKELGRAPH" launch "$SRC/bringup/openni2_dummy.yaml" --duration 14 --json) >"$WORK/live.json" 2>"$WORK/live.err" &
+(cd "$WORK" && exec "$SKELGRAPH" launch "$SRC/bringup/openni2_dummy.yaml" --duration 60 --json) >"$WORK/live.json" 2>"$WORK/live.err" &
 live=$!
 "$SKELGRAPH" run openni2 --name raw_rec -p sensor_id=depth2 -p record_directory="$WORK/raw" -p mend_recordings=false \
-  --duration 14 --json >"$WORK/raw.json" 2>"$WORK/raw.err" &
+  --duration 60 --json >"$WORK/raw.json" 2>"$WORK/raw.err" &
 raw=$!
-"$SKELGRAPH" topic hz skelgraph/depth --json --window 3 --timeout 10 >"$WORK/hz.json" 2>"$WORK/hz.err" || fail "no depth: $(cat "$WORK/hz.err")"
-# Two Dummy devices publish: ~60 Hz together. More than one device can give
-# (30 Hz), with room for a loaded machine: a clean-clone run on 2 cores beside
-# test_depth_tracker and calib measured 48 Hz.
-json_check "$WORK/hz.json" '40 < d["rate_hz"] < 70'
-"$SKELGRAPH" topic echo skelgraph/depth --count 1 --json --timeout 5 >"$WORK/echo.json"
-json_check "$WORK/echo.json" 'd["data"]["width"] == 320 and d["data"]["height"] == 240 and d["data"]["depth_mm_count"] == 76800 and d["data"]["depth_mm_valid"] > 300'
+# Both devices deliver 320x240 depth (their rate is the benchmarks' business).
+"$SKELGRAPH" topic echo skelgraph/depth --count 30 --json --timeout 15 >"$WORK/echo.jsonl" 2>"$WORK/echo.err" || fail "no depth: $(cat "$WORK/echo.err")"
+python3 - "$WORK/echo.jsonl" <<'PY' || fail "depth samples: $(head -c 600 "$WORK/echo.jsonl")"
+import json, sys
+d = [json.loads(l)["data"] for l in open(sys.argv[1])]
+assert {x["sensor_id"] for x in d} == {"depth1", "depth2"}, {x["sensor_id"] for x in d}
+assert all(x["width"] == 320 and x["height"] == 240 and x["depth_mm_count"] == 76800 and x["depth_mm_valid"] > 300 for x in d), d[0]
+PY
 "$SKELGRAPH" sync start --label oni --timeout 10 >/dev/null || fail "sync start"
-sleep 3
+# A session of about 3 s: while 180 frames of the two devices go by.
+"$SKELGRAPH" topic echo skelgraph/depth --count 180 --json --timeout 15 >/dev/null 2>&1 || fail "depth stopped during the session"
 "$SKELGRAPH" sync stop --timeout 10 >/dev/null || fail "sync stop"
+kill -INT "$live" "$raw"
 wait "$live" || fail "launch: $(tail -5 "$WORK/live.err")"
 wait "$raw" || fail "raw recorder: $(tail -5 "$WORK/raw.err")"
-ok "live Dummy depth at $(json_get "$WORK/hz.json" 'round(d["rate_hz"], 1)') Hz from two devices"
+ok "live Dummy depth from two devices, a session recorded by both"
 
 mended=$(ls "$WORK"/recordings/oni/depth1_session*.oni 2>/dev/null | tail -1)
 [ -n "$mended" ] || fail "no recording in recordings/oni: $(cat "$WORK/live.json")"
@@ -66,13 +69,13 @@ player=$!
 json_check "$WORK/st0.json" 'd[0]["paused"] and d[0]["frames"] == 0 and d[0]["frame_count"] == '"$frames"
 "$SKELGRAPH" topic echo skelgraph/depth --count 3 --json --timeout 15 >"$WORK/steps.jsonl" 2>"$WORK/steps.err" &
 echo_pid=$!
-sleep 2  # the echo's reader matched
+wait_for_match "$WORK/steps.err" "echo: matched" 10 || fail "the echo found no depth writer: $(cat "$WORK/steps.err")"
 "$SKELGRAPH" player step --frames 3 --target player1 --json >"$WORK/st1.json" || fail "step"
 json_check "$WORK/st1.json" 'd[0]["paused"] and d[0]["frames"] == 3 and d[0]["error"] == ""'
 wait "$echo_pid" || fail "echo of the stepped frames: $(cat "$WORK/steps.err")"
 python3 -c 'import json, sys; n = [json.loads(l)["data"]["frame_number"] for l in open(sys.argv[1])]; sys.exit(n != [1, 2, 3])' \
   "$WORK/steps.jsonl" || fail "stepped frames: $(cut -c1-200 "$WORK/steps.jsonl")"
-sleep 1
+sleep 1  # a second in which nothing may come: the player is paused
 "$SKELGRAPH" player state --target player1 --json >"$WORK/st2.json"
 json_check "$WORK/st2.json" 'd[0]["frames"] == 3'  # paused: nothing more
 if "$SKELGRAPH" player speed 2000 --target player1 2>/dev/null; then fail "speed 2000 accepted"; fi

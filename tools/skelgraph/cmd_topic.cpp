@@ -131,7 +131,13 @@ int echo(const runtime::DdsConfig& config, const std::string& topic, std::size_t
       });
   s.context->executor().start();
   const auto deadline_first = std::chrono::steady_clock::now() + seconds(timeout_s);
+  bool said_matched = false;
   while (true) {
+    // Said once on stderr, so that a script can wait for the reader instead of sleeping.
+    if (!said_matched && sub.matched() > 0) {
+      std::fprintf(stderr, "echo: matched %zu writer(s) on %s\n", sub.matched(), topic.c_str());
+      said_matched = true;
+    }
     {
       std::unique_lock<std::mutex> lock(mutex);
       if (count > 0 && printed >= count) break;
@@ -235,7 +241,8 @@ void add_topic_command(CLI::App& app, GlobalOptions& g, Action& run) {
   add_dds_options(*l, g);
   l->callback([o, &g, &run] { run = [o, &g] { return list(make_config(g), o->wait, o->json, o->all); }; });
 
-  auto* e = topic->add_subcommand("echo", "Print the samples published on a topic, decoded");
+  auto* e = topic->add_subcommand(
+      "echo", "Print the samples published on a topic, decoded (stderr says 'echo: matched N writer(s)' once one is)");
   e->add_option("topic", o->topic, "topic name, e.g. skelgraph/sync")->required();
   e->add_option("--count", o->count, "exit after N samples (default: until Ctrl-C)");
   e->add_option("--timeout", o->timeout, "fail if nothing arrives within S seconds (0: wait forever)")
