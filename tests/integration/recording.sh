@@ -27,9 +27,9 @@ PY
   sleep 0.2
 done
 "$SKELGRAPH" sync start --label two_hosts --timeout 20 >/dev/null 2>"$WORK/start.err" || fail "sync start: $(cat "$WORK/start.err"); master: $(tail -5 "$WORK/sync.err")"
-sleep 6
+# A session of about 6 s: while 170 ticks go by (the master ticks at 30 Hz).
+"$SKELGRAPH" topic echo skelgraph/sync --count 170 --timeout 30 >/dev/null 2>"$WORK/ticks.err" || fail "ticks: $(cat "$WORK/ticks.err")"
 "$SKELGRAPH" sync stop --timeout 20 >/dev/null
-sleep 1
 kill -INT "$a" "$b" "$sync"
 wait "$a" || fail "recorder A: $(cat "$WORK/a.err")"
 wait "$b" || fail "recorder B: $(cat "$WORK/b.err")"
@@ -70,9 +70,9 @@ a_file=$(ls "$WORK/rec"/two_hosts_*_hostA.mcap)
 kill -INT "$sim"; wait "$sim" || true
 "$SKELGRAPH" bag record --now --label replay --dir "$WORK/replay" --duration 40 >/dev/null 2>"$WORK/r.err" &
 rec=$!
-sleep 2
+wait_for_match "$WORK/r.err" "recording session" 20 || fail "re-recorder did not start: $(cat "$WORK/r.err")"
 timeout 60 "$SKELGRAPH" bag play "$a_file" --json >"$WORK/play.json" 2>"$WORK/play.err" || fail "play (ends by itself at the end of the file): $(cat "$WORK/play.err")"
-sleep 1
+sleep 1  # the recorder writes what its readers acknowledged
 kill -INT "$rec"; wait "$rec" || fail "re-record: $(cat "$WORK/r.err")"
 "$SKELGRAPH" bag info "$a_file" --json >"$WORK/orig.json"
 "$SKELGRAPH" bag info "$WORK/replay"/replay_*.mcap --json >"$WORK/again.json"
@@ -100,7 +100,9 @@ ok "replay re-recorded: reliable topics identical"
 sim=$!
 "$SKELGRAPH" bag record --now --label killed --dir "$WORK/kill" --compression lz4 >/dev/null 2>"$WORK/k.err" &
 rec=$!
-sleep 5
+wait_for_match "$WORK/k.err" "recording session" 20 || fail "recorder did not start: $(cat "$WORK/k.err")"
+# About 5 s of the two sensors' skeletons (60 a second) recorded, then the kill.
+"$SKELGRAPH" topic echo skelgraph/skeleton/raw --count 300 --timeout 30 >/dev/null 2>&1 || fail "no raw skeletons to record"
 kill -9 "$rec"
 killed_ns=$(python3 -c 'import time; print(time.time_ns())')
 wait "$rec" 2>/dev/null || true

@@ -144,9 +144,11 @@ void BagPlayer::run() {
         player_->sought();
       }
     }
-    {  // let readers take (and reliable readers acknowledge) the last samples before the graph may stop
-      std::unique_lock lock(mutex_);
-      cv_.wait_for(lock, std::chrono::milliseconds(500), [this] { return stop_; });
+    // Reliable readers acknowledge the last samples before the graph may stop (bounded: 2 s in all).
+    const auto acks_deadline = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+    for (auto& p : publishers_) {
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(acks_deadline - std::chrono::steady_clock::now());
+      if (left.count() <= 0 || !p->wait_for_acks(left)) break;
     }
     ctx_.set_health(failed_ ? runtime::HealthState::Degraded : runtime::HealthState::Ok,
                     failed_ ? std::to_string(failed_.load()) + " message(s) could not be republished" : "finished");

@@ -203,6 +203,8 @@ class RawPublisher {
   // False when the payload does not decode as the participant's typed support, or DDS refuses it.
   bool publish(const msg::RawSample& sample, std::int64_t active_ns = WriterBase::kNow);
   std::size_t matched() const { return base_.matched(); }
+  // Reliable writers: waits until every matched reader acknowledged.
+  bool wait_for_acks(std::chrono::milliseconds timeout) { return base_.wait_for_acks(timeout); }
   // Keyed: disposes the instances not active since then (WriterBase::dispose_idle).
   std::size_t dispose_idle(std::int64_t before_ns) { return base_.dispose_idle(before_ns); }
 
