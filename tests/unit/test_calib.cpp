@@ -10,6 +10,7 @@
 #include <map>
 #include <random>
 
+#include "skelgraph/calib/calibration_step.hpp"
 #include "skelgraph/calib/rigid.hpp"
 #include "skelgraph/calib/skeleton_calib.hpp"
 #include "skelgraph/skeleton/stats.hpp"
@@ -247,6 +248,39 @@ TEST(SkeletonCalib, HeldOutDistancesShrink) {
   const auto after = stats::upper_median(calib::joint_distances(p.ref, p.other, r.fit.transform()));
   EXPECT_GT(before, 0.3);  // the sensors' frames are far apart
   EXPECT_LT(after, 0.08);
+}
+
+// The acceptance policy every calibration step shares (calibration_step.hpp):
+// a fit from the first half replaces the pose before when it brings the
+// skeletons closer; the pose it found is never traded for a worse one; an
+// undecided fit is never taken, however close; and the held-out half agrees.
+TEST(CalibrationStep, APoseIsTakenOnlyWhenItBringsTheSkeletonsCloser) {
+  const auto p = simulate("walk", 1, 30);
+  const calib::SensorSkeletons data{{"a", p.ref}, {"b", p.other}};
+  const auto halves = calib::split_halves(data, "a");
+  ASSERT_FALSE(halves.fit.at("b").empty());
+  ASSERT_FALSE(halves.test.at("b").empty());
+  EXPECT_LT(halves.fit.at("a").back().t_ns, halves.test.at("a").front().t_ns);
+  EXPECT_EQ(halves.fit.at("a").size() + halves.test.at("a").size(), p.ref.size());
+
+  const auto step = calib::calibrate_pair_step(halves.fit.at("a"), halves.fit.at("b"), Eigen::Isometry3d::Identity());
+  EXPECT_TRUE(step.acceptance.improved);
+  EXPECT_LT(step.acceptance.after_m, 0.5 * step.acceptance.before_m);
+  EXPECT_TRUE(step.chosen.isApprox(step.fit.fit.transform()));
+  // Held out: closer too.
+  const auto held = calib::accept_pose(halves.test.at("a"), halves.test.at("b"), Eigen::Isometry3d::Identity(), step.chosen);
+  EXPECT_TRUE(held.improved) << held.before_m << " -> " << held.after_m;
+  // Starting from the truth, a candidate 10 cm off is refused and the pose before is kept.
+  Eigen::Isometry3d off = p.truth;
+  off.pretranslate(Eigen::Vector3d(0.10, 0, 0));
+  const auto worse = calib::accept_pose(p.ref, p.other, p.truth, off);
+  EXPECT_FALSE(worse.improved);
+  EXPECT_GT(worse.after_m, worse.before_m);
+  // Undecided is never taken; NaN before (nothing matched under the old pose) is beaten by any distance.
+  EXPECT_FALSE(calib::accept(0.5, 0.01, true).improved);
+  EXPECT_TRUE(calib::accept(std::nan(""), 0.3, false).improved);
+  EXPECT_FALSE(calib::accept(0.02, 0.02, false).improved);  // not closer: the previous pose stays
+  EXPECT_THROW(calib::split_halves(data, "c"), calib::CalibError);
 }
 
 // The floor search (calib skeleton --best-rigid): started 5 cm and 3 degrees

@@ -19,7 +19,7 @@
 #include "skelgraph/skeleton/json_number.hpp"
 #include "skelgraph/skeleton/stats.hpp"
 #include "skelgraph/calib/calib_file.hpp"
-#include "skelgraph/calib/cell_calib.hpp"
+#include "skelgraph/calib/calibration_step.hpp"
 #include "skelgraph/calib/skeleton_calib.hpp"
 #include "skelgraph/eval/metrics.hpp"
 #include "skelgraph/mcap/mcap.hpp"
@@ -143,40 +143,16 @@ std::vector<skeleton::JointId> upper_body() {
   return upper;
 }
 
-// An input's skeletons split in time at the middle of the reference's: the first half to fit, the second to check.
-std::pair<std::map<std::string, std::vector<calib::TimedSkeleton>>, std::map<std::string, std::vector<calib::TimedSkeleton>>>
-split_halves(const Input& in, const std::string& ref) {
-  const auto& r = in.by_sensor.at(ref);
-  std::int64_t lo = r.front().t_ns, hi = r.front().t_ns;
-  for (const auto& x : r) lo = std::min(lo, x.t_ns), hi = std::max(hi, x.t_ns);
-  const std::int64_t mid = lo + (hi - lo) / 2;
-  std::map<std::string, std::vector<calib::TimedSkeleton>> fit, test;
-  for (const auto& [id, v] : in.by_sensor)
-    for (const auto& x : v) (x.t_ns < mid ? fit[id] : test[id]).push_back(x);
-  return {fit, test};
-}
-
-// Median distance between one sensor's skeletons and every other sensor's
-// under the given poses (reference_from_sensor); NaN when none match.
-double cell_median(const std::map<std::string, std::vector<calib::TimedSkeleton>>& data, const std::string& s,
-                   const std::map<std::string, Eigen::Isometry3d>& poses, const std::vector<skeleton::JointId>& joints) {
-  std::vector<double> all;
-  if (!data.count(s) || !poses.count(s)) return std::nan("");
-  for (const auto& [t, v] : data) {
-    if (t == s || !poses.count(t)) continue;
-    const auto d = calib::joint_distances(data.at(s), v, poses.at(s).inverse() * poses.at(t), 0, joints, 2.0);
-    all.insert(all.end(), d.begin(), d.end());
-  }
-  return stats::upper_median(all);
-}
-
 // Every sensor of one input at once (no --other and more than one other sensor).
 nlohmann::json calibrate_cell_input(const std::string& path, const SkelOptions& o, const Input& in,
                                     std::vector<skeleton::SensorPose>* result) {
-  std::map<std::string, std::vector<calib::TimedSkeleton>> fit = in.by_sensor, test;
-  if (o.holdout) std::tie(fit, test) = split_halves(in, o.ref);
+  calib::SensorSkeletons fit = in.by_sensor, test;
+  if (o.holdout) {
+    auto halves = calib::split_halves(in.by_sensor, o.ref);
+    fit = std::move(halves.fit), test = std::move(halves.test);
+  }
   // The poses the input already implies (a shared frame when it has none).
-  std::map<std::string, Eigen::Isometry3d> before;
+  calib::SensorPoses before;
   for (const auto& [id, v] : in.by_sensor) {
     before[id] = in.poses.count(o.ref) && in.poses.count(id) ? Eigen::Isometry3d(in.poses.at(o.ref).inverse() * in.poses.at(id))
                                                              : Eigen::Isometry3d::Identity();
@@ -185,15 +161,14 @@ nlohmann::json calibrate_cell_input(const std::string& path, const SkelOptions& 
   co.pair.inlier_threshold_m = o.threshold_m;
   co.pair.robust_scale_m = o.robust_scale_m;
   co.prior = in.poses;
-  calib::CellCalibResult r;
+  calib::CellStep step;
   try {
-    r = calib::calibrate_cell(fit, o.ref, co);
+    step = calib::calibrate_cell_step(fit, o.ref, before, co);
   } catch (const calib::CalibError& e) {
     throw UsageError(path + ": cannot calibrate the cell against " + o.ref + ": " + e.what());
   }
-  std::map<std::string, Eigen::Isometry3d> after = before, chosen = before;
-  for (const auto& s : r.sensors)
-    if (s.placed) after[s.id] = s.reference_from_sensor;
+  const auto& r = step.fit;
+  const auto& chosen = step.chosen;
   const auto upper = upper_body();
   nlohmann::json j{{"input", path}, {"reference", o.ref}, {"mode", "cell"}, {"joint_solution_rounds", r.rounds}};
   auto& sensors = j["sensors"] = nlohmann::json::array();
@@ -209,17 +184,15 @@ nlohmann::json calibrate_cell_input(const std::string& path, const SkelOptions& 
       continue;
     }
     // Never worse than before, sensor by sensor, on the data it was fitted to.
-    const double fb = cell_median(fit, s.id, before, {});
-    const double fa = cell_median(fit, s.id, after, {});
-    const bool improved = !s.ambiguous && !(fa >= fb);
-    if (improved) chosen[s.id] = after[s.id];
+    const auto& acc = step.acceptance.at(s.id);
+    const bool improved = acc.improved;
     sj["path"] = s.path;
     sj["reference_from_sensor"] = pose_json(s.reference_from_sensor);
     sj["joint_pairs"] = s.pairs;
     sj["median_distance_cm"] = json_number(cm(s.median_m));
     sj["rms_residual_cm"] = json_number(cm(s.rms_m));
     sj["max_residual_cm"] = json_number(cm(s.max_m));
-    sj["fit_median_distance_cm"] = {{"before", json_number(cm(fb))}, {"after", json_number(cm(fa))}};
+    sj["fit_median_distance_cm"] = {{"before", json_number(cm(acc.before_m))}, {"after", json_number(cm(acc.after_m))}};
     sj["improved"] = improved;
     sj["undecided"] = s.ambiguous;
     if (s.ambiguous) ++undecided;
@@ -231,8 +204,8 @@ nlohmann::json calibrate_cell_input(const std::string& path, const SkelOptions& 
   if (o.holdout) {
     for (auto& sj : sensors) {
       const auto id = sj["sensor"].get<std::string>();
-      sj["held_out_median_distance_cm"] = {{"before", json_number(cm(cell_median(test, id, before, upper)))},
-                                           {"after", json_number(cm(cell_median(test, id, chosen, upper)))}};
+      sj["held_out_median_distance_cm"] = {{"before", json_number(cm(calib::cell_median(test, id, before, upper)))},
+                                           {"after", json_number(cm(calib::cell_median(test, id, chosen, upper)))}};
     }
   }
   auto& links = j["links"] = nlohmann::json::array();
@@ -295,7 +268,7 @@ nlohmann::json calibrate_one(const std::string& path, const SkelOptions& o, std:
 
   std::vector<calib::TimedSkeleton> fit_ref = ref, fit_oth = oth, test_ref, test_oth;
   if (o.holdout) {
-    auto [fit, test] = split_halves(in, o.ref);
+    auto [fit, test] = calib::split_halves(in.by_sensor, o.ref);
     fit_ref = fit[o.ref], fit_oth = fit[other], test_ref = test[o.ref], test_oth = test[other];
   }
   calib::SkeletonCalibOptions co;
@@ -303,19 +276,17 @@ nlohmann::json calibrate_one(const std::string& path, const SkelOptions& o, std:
   co.robust_scale_m = o.robust_scale_m;
   co.max_clock_offset_ns = static_cast<std::int64_t>(o.clock_search_ms * 1e6);
   if (in.poses.count(o.ref) && in.poses.count(other)) co.prior = before;
-  calib::SkeletonCalibResult r;
+  calib::PairStep step;
   try {
-    r = calib::calibrate_from_skeletons(fit_ref, fit_oth, co);
+    step = calib::calibrate_pair_step(fit_ref, fit_oth, before, co);
   } catch (const calib::CalibError& e) {
     throw UsageError(path + ": cannot calibrate " + other + " against " + o.ref + ": " + e.what());
   }
   // Never worse than before: judged on the data it was fitted to (the held-out half stays unseen).
-  const double fit_before = stats::upper_median(calib::joint_distances(fit_ref, fit_oth, before, 0, {}, 2.0));
-  const double fit_after = stats::upper_median(calib::joint_distances(fit_ref, fit_oth, r.fit.transform(), r.clock_offset_ns, {}, 2.0));
-  const bool undecided = r.ambiguous && !r.resolved_by_prior;
-  const bool improved = !undecided && !(fit_after >= fit_before);
-  const Eigen::Isometry3d chosen = improved ? r.fit.transform() : before;
-  const std::int64_t chosen_offset = improved ? r.clock_offset_ns : 0;
+  const auto& r = step.fit;
+  const bool undecided = step.acceptance.undecided, improved = step.acceptance.improved;
+  const Eigen::Isometry3d chosen = step.chosen;
+  const std::int64_t chosen_offset = step.chosen_offset_ns;
 
   nlohmann::json j{{"input", path},
                    {"reference", o.ref},
@@ -334,7 +305,8 @@ nlohmann::json calibrate_one(const std::string& path, const SkelOptions& o, std:
                    {"inliers", r.inliers},
                    {"rms_residual_cm", cm(r.fit.rms)},
                    {"max_residual_cm", cm(r.fit.max)},
-                   {"fit_median_distance_cm", {{"before", json_number(cm(fit_before))}, {"after", json_number(cm(fit_after))}}}};
+                   {"fit_median_distance_cm",
+                    {{"before", json_number(cm(step.acceptance.before_m))}, {"after", json_number(cm(step.acceptance.after_m))}}}};
   nlohmann::json per = nlohmann::json::object();
   for (const auto& jr : r.per_joint) {
     per[skeleton::joint_name(jr.joint)] = {{"pairs", jr.pairs}, {"median_cm", json_number(cm(jr.median_m))}, {"rms_cm", json_number(cm(jr.rms_m))}};
