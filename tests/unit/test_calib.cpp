@@ -617,31 +617,31 @@ TEST(Board, CornersAreFoundWhereTheyProject) {
     for (std::size_t i = 0; i < obj.size(); ++i) {
       const Vector3d q = cb * obj[i];
       const double u = s.k.fx * q.x() / q.z() + s.k.cx, w = s.k.fy * q.y() / q.z() + s.k.cy;
-      worst = std::max(worst, std::hypot((*corners)[i].x - u, (*corners)[i].y - w));
+      worst = std::max(worst, std::hypot((*corners)[i].x() - u, (*corners)[i].y() - w));
     }
   }
   EXPECT_LT(worst, 0.5);  // pixels, in the board's own order (not turned by 180 degrees)
   // No board, no corners.
-  EXPECT_FALSE(calib::find_corners(cv::Mat(480, 640, CV_8U, cv::Scalar(128)), s.board));
+  EXPECT_FALSE(calib::find_corners(calib::GreyImage{640, 480, std::vector<std::uint8_t>(640 * 480, 128)}, s.board));
 }
 
 TEST(Board, IntrinsicsFromViews) {
   auto s = board_scene(1);
   // Views for one sensor only: the board turned towards it, tilted every way.
   s.boards = calib::board_poses_seen_by({s.sensors[0]}, s.board, s.k, 15, Vector3d(0, 1.2, 0.6), 12);
-  std::vector<std::vector<cv::Point2f>> all;
+  std::vector<calib::Corners> all;
   for (std::size_t v = 0; v < s.boards.size(); ++v) {
     const auto view = calib::render_board_view(s.board, s.k, calib::camera_from_board(s.sensors[0], s.boards[v]), 2.0, 1.0, v);
     if (auto c = calib::find_corners(view.grey, s.board)) all.push_back(*c);
   }
   ASSERT_GE(all.size(), 12u);
-  const auto r = calib::calibrate_intrinsics(all, s.board, cv::Size(640, 480));
+  const auto r = calib::calibrate_intrinsics(all, s.board, 640, 480);
   EXPECT_NEAR(r.intrinsics.fx, 525, 525 * 0.01);
   EXPECT_NEAR(r.intrinsics.fy, 525, 525 * 0.01);
   EXPECT_NEAR(r.intrinsics.cx, 319.5, 4);
   EXPECT_NEAR(r.intrinsics.cy, 239.5, 4);
   EXPECT_LT(r.rms_reprojection_px, 0.5);
-  EXPECT_THROW(calib::calibrate_intrinsics({all[0], all[1]}, s.board, cv::Size(640, 480)), CalibError);
+  EXPECT_THROW(calib::calibrate_intrinsics({all[0], all[1]}, s.board, 640, 480), CalibError);
 }
 
 TEST(Board, TwentyViewsGiveTheExtrinsics) {

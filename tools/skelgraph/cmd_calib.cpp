@@ -12,7 +12,6 @@
 #include <optional>
 
 #include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
 
 #include "cli.hpp"
 #include "skelgraph/calib/board.hpp"
@@ -600,12 +599,6 @@ struct BoardOptions {
   bool json = false;
 };
 
-cv::Mat read_image(const std::string& path, int flags) {
-  cv::Mat m = cv::imread(path, flags);
-  if (m.empty()) throw UsageError(path + ": cannot read the image (missing, or not an image OpenCV reads)");
-  return m;
-}
-
 calib::Board board_of(const BoardOptions& o) {
   try {
     return calib::Board::parse(o.size, o.square_m);
@@ -616,15 +609,22 @@ calib::Board board_of(const BoardOptions& o) {
 
 int calib_intrinsics(const BoardOptions& o) {
   const auto board = board_of(o);
-  std::vector<std::vector<cv::Point2f>> found;
+  std::vector<calib::Corners> found;
   std::vector<std::string> missed;
-  cv::Size size;
+  int width = 0, height = 0;
   Progress progress(!o.json);
   for (std::size_t i = 0; i < o.images.size(); ++i) {
-    const cv::Mat grey = read_image(o.images[i], cv::IMREAD_GRAYSCALE);
-    if (size.area() == 0) size = grey.size();
-    if (grey.size() != size) throw UsageError(o.images[i] + ": " + std::to_string(grey.cols) + "x" + std::to_string(grey.rows) +
-                                              ", the other images are " + std::to_string(size.width) + "x" + std::to_string(size.height));
+    calib::GreyImage grey;
+    try {
+      grey = calib::read_grey_image(o.images[i]);
+    } catch (const calib::CalibError& e) {
+      throw UsageError(e.what());
+    }
+    if (width == 0) width = grey.width, height = grey.height;
+    if (grey.width != width || grey.height != height) {
+      throw UsageError(o.images[i] + ": " + std::to_string(grey.width) + "x" + std::to_string(grey.height) +
+                       ", the other images are " + std::to_string(width) + "x" + std::to_string(height));
+    }
     if (auto c = calib::find_corners(grey, board)) found.push_back(std::move(*c));
     else missed.push_back(o.images[i]);
     progress("looking for the board: " + std::to_string(i + 1) + " of " + std::to_string(o.images.size()) + " images",
@@ -637,7 +637,7 @@ int calib_intrinsics(const BoardOptions& o) {
   }
   calib::IntrinsicsResult r;
   try {
-    r = calib::calibrate_intrinsics(found, board, size);
+    r = calib::calibrate_intrinsics(found, board, width, height);
   } catch (const calib::CalibError& e) {
     throw UsageError(e.what());
   }
@@ -666,22 +666,6 @@ int calib_intrinsics(const BoardOptions& o) {
   return good ? 0 : 1;
 }
 
-// Views in DIR: NAME_color.png with NAME_depth.png (16-bit mm, registered to the colour image).
-std::vector<std::string> view_names(const std::string& dir) {
-  std::vector<std::string> names;
-  std::error_code ec;
-  for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
-    const auto f = e.path().filename().string();
-    const std::string tail = "_color.png";
-    if (f.size() > tail.size() && f.compare(f.size() - tail.size(), tail.size(), tail) == 0) {
-      names.push_back(f.substr(0, f.size() - tail.size()));
-    }
-  }
-  if (ec) throw UsageError(dir + ": " + ec.message());
-  std::sort(names.begin(), names.end());
-  return names;
-}
-
 calib::Intrinsics intrinsics_for(const std::string& dir, const std::string& given) {
   const std::string path = given.empty() ? (std::filesystem::path(dir) / "intrinsics.yaml").string() : given;
   if (!std::filesystem::exists(path)) {
@@ -695,30 +679,21 @@ calib::Intrinsics intrinsics_for(const std::string& dir, const std::string& give
   }
 }
 
-// One view NAME in DIR: the board's corners found in NAME_color.png and
-// lifted to 3-D (camera frame) with NAME_depth.png; nothing, with the reason
-// in `why`, when the view is missing or the board is not usable in it.
+// The library's board views, an unreadable file being a usage error (the user named it).
+std::vector<std::string> view_names(const std::string& dir) {
+  try {
+    return calib::board_view_names(dir);
+  } catch (const calib::CalibError& e) {
+    throw UsageError(e.what());
+  }
+}
 std::optional<std::vector<Eigen::Vector3d>> lift_view(const std::string& dir, const std::string& name,
                                                       const calib::Board& board, const calib::Intrinsics& k,
                                                       std::string* why) {
-  const std::filesystem::path d = dir;
-  const auto colour = (d / (name + "_color.png")).string(), depth = (d / (name + "_depth.png")).string();
-  if (!std::filesystem::exists(colour) || !std::filesystem::exists(depth)) {
-    *why = name + ": no colour and depth image in " + dir;
-    return std::nullopt;
-  }
-  const auto corners = calib::find_corners(read_image(colour, cv::IMREAD_GRAYSCALE), board);
-  if (!corners) {
-    *why = name + ": board not found in " + colour;
-    return std::nullopt;
-  }
-  const cv::Mat dm = read_image(depth, cv::IMREAD_ANYDEPTH);
-  if (dm.type() != CV_16U) throw UsageError(depth + ": expected a 16-bit depth image (millimetres)");
   try {
-    return calib::lift_corners(*corners, dm, k, board).points;
+    return calib::lift_board_view(dir, name, board, k, why);
   } catch (const calib::CalibError& e) {
-    *why = name + ": " + e.what();
-    return std::nullopt;
+    throw UsageError(e.what());
   }
 }
 

@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli.hpp"
-#include <opencv2/imgcodecs.hpp>
+#include <opencv2/core.hpp>  // cv::RNG: the sequences the simulated boards and tool poses were drawn from
 
 #include "skelgraph/calib/board.hpp"
 #include "skelgraph/calib/calib_file.hpp"
@@ -48,6 +48,16 @@ sim::SimConfig sim_config(const std::vector<std::string>& assignments, const cha
 }
 
 namespace {
+
+// A board view as BASE_color.png (and BASE_depth.png).
+void write_view(const std::filesystem::path& base, const calib::BoardView& view, bool depth) {
+  try {
+    calib::write_png(base.string() + "_color.png", view.grey);
+    if (depth) calib::write_png(base.string() + "_depth.png", view.depth_mm);
+  } catch (const calib::CalibError& e) {
+    throw UsageError(e.what());
+  }
+}
 
 int table(const sim::RealismOptions& opt, bool json, bool check) {
   nlohmann::json out = nlohmann::json::array();
@@ -215,10 +225,7 @@ int write_robot_boards(const BoardsOpts& o, const sim::SimConfig& cfg, const cal
       const auto view = calib::render_board_view(board, k, calib::camera_from_board(sensors[si], boards[v]), o.grey_noise,
                                                  o.depth_noise, o.seed * 1000003 + 1000 * si + v);
       std::snprintf(name, sizeof name, "%03zu", v);
-      if (!cv::imwrite((dir / (std::string(name) + "_color.png")).string(), view.grey) ||
-          !cv::imwrite((dir / (std::string(name) + "_depth.png")).string(), view.depth_mm)) {
-        throw UsageError((dir / name).string() + ": cannot write the image");
-      }
+      write_view(dir / name, view, true);
       images += 2;
       ++per_sensor[si];
     }
@@ -261,7 +268,6 @@ int write_boards(const BoardsOpts& o) {
   std::vector<Eigen::Isometry3d> sensors;
   for (const auto& s : cfg.sensors) sensors.push_back(s.world_from_sensor());
   const Eigen::Vector3d centre(0, 1.2, 0);
-  const auto fail_write = [](const std::string& f) { throw UsageError(f + ": cannot write the image"); };
   std::vector<Eigen::Isometry3d> shared;
   try {
     shared = calib::board_poses_seen_by(sensors, board, k, o.views, centre, o.seed);
@@ -277,8 +283,7 @@ int write_boards(const BoardsOpts& o) {
       const auto view = calib::render_board_view(board, k, calib::camera_from_board(sensors[si], shared[v]), o.grey_noise,
                                                  o.depth_noise, o.seed * 1000003 + 1000 * si + v);
       std::snprintf(name, sizeof name, "%03zu", v);
-      if (!cv::imwrite((dir / (std::string(name) + "_color.png")).string(), view.grey)) fail_write(name);
-      if (!cv::imwrite((dir / (std::string(name) + "_depth.png")).string(), view.depth_mm)) fail_write(name);
+      write_view(dir / name, view, true);
       images += 2;
     }
     const Eigen::Vector3d in_front = cfg.sensors[si].position + 0.55 * (centre - cfg.sensors[si].position);
@@ -287,7 +292,7 @@ int write_boards(const BoardsOpts& o) {
       const auto view = calib::render_board_view(board, k, calib::camera_from_board(sensors[si], own[v]), o.grey_noise,
                                                  o.depth_noise, o.seed * 7919 + 1000 * si + v);
       std::snprintf(name, sizeof name, "%03zu", v);
-      if (!cv::imwrite((dir / "intrinsics" / (std::string(name) + "_color.png")).string(), view.grey)) fail_write(name);
+      write_view(dir / "intrinsics" / name, view, false);
       ++images;
     }
     calib::write_intrinsics_file((dir / "intrinsics_truth.yaml").string(), k, 0.0, 0, "the simulated camera's true intrinsics");

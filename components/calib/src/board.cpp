@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 
 #include <Eigen/SVD>
 #include <opencv2/calib3d.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "skelgraph/calib/rigid.hpp"
@@ -34,9 +37,26 @@ std::vector<Vector3d> Board::object_points() const {
   return p;
 }
 
-cv::Mat camera_matrix(const Intrinsics& k) { return (cv::Mat_<double>(3, 3) << k.fx, 0, k.cx, 0, k.fy, k.cy, 0, 0, 1); }
-
 namespace {
+// OpenCV views of skelgraph's images (no copy) and back.
+cv::Mat as_mat(const GreyImage& g) {
+  return cv::Mat(g.height, g.width, CV_8U, const_cast<std::uint8_t*>(g.pixels.data()));
+}
+cv::Mat as_mat(const DepthImageMm& d) { return cv::Mat(d.height, d.width, CV_16U, const_cast<std::uint16_t*>(d.mm.data())); }
+GreyImage grey_of(const cv::Mat& m) {
+  GreyImage g;
+  g.width = m.cols, g.height = m.rows;
+  g.pixels.resize(static_cast<std::size_t>(m.cols) * static_cast<std::size_t>(m.rows));
+  for (int v = 0; v < m.rows; ++v) std::copy_n(m.ptr<std::uint8_t>(v), m.cols, g.pixels.data() + static_cast<std::size_t>(v) * m.cols);
+  return g;
+}
+std::vector<cv::Point2f> points_of(const Corners& c) {
+  std::vector<cv::Point2f> p;
+  p.reserve(c.size());
+  for (const auto& x : c) p.emplace_back(x.x(), x.y());
+  return p;
+}
+
 // Mean grey level of a small patch around a point.
 double grey_at(const cv::Mat& grey, cv::Point2f p) {
   cv::Mat patch;
@@ -45,7 +65,32 @@ double grey_at(const cv::Mat& grey, cv::Point2f p) {
 }
 }  // namespace
 
-std::optional<std::vector<cv::Point2f>> find_corners(const cv::Mat& grey, const Board& board) {
+GreyImage read_grey_image(const std::string& path) {
+  const cv::Mat m = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  if (m.empty()) throw CalibError(path + ": cannot read the image (missing, or not an image OpenCV reads)");
+  return grey_of(m);
+}
+
+DepthImageMm read_depth_image(const std::string& path) {
+  const cv::Mat m = cv::imread(path, cv::IMREAD_ANYDEPTH);
+  if (m.empty()) throw CalibError(path + ": cannot read the image (missing, or not an image OpenCV reads)");
+  if (m.type() != CV_16U) throw CalibError(path + ": expected a 16-bit depth image (millimetres)");
+  DepthImageMm d;
+  d.width = m.cols, d.height = m.rows;
+  d.mm.resize(static_cast<std::size_t>(m.cols) * static_cast<std::size_t>(m.rows));
+  for (int v = 0; v < m.rows; ++v) std::copy_n(m.ptr<std::uint16_t>(v), m.cols, d.mm.data() + static_cast<std::size_t>(v) * m.cols);
+  return d;
+}
+
+void write_png(const std::string& path, const GreyImage& image) {
+  if (!cv::imwrite(path, as_mat(image))) throw CalibError(path + ": cannot write the image");
+}
+void write_png(const std::string& path, const DepthImageMm& image) {
+  if (!cv::imwrite(path, as_mat(image))) throw CalibError(path + ": cannot write the image");
+}
+
+std::optional<Corners> find_corners(const GreyImage& grey_image, const Board& board) {
+  const cv::Mat grey = as_mat(grey_image);
   std::vector<cv::Point2f> corners;
   const cv::Size pattern(board.cols, board.rows);
   if (!cv::findChessboardCorners(grey, pattern, corners,
@@ -67,11 +112,16 @@ std::optional<std::vector<cv::Point2f>> find_corners(const cv::Mat& grey, const 
   const int c = board.cols;
   const auto centre = [&](int a) { return (corners[a] + corners[a + 1] + corners[a + c] + corners[a + c + 1]) * 0.25f; };
   if (grey_at(grey, centre(0)) > grey_at(grey, centre(1))) std::reverse(corners.begin(), corners.end());
-  return corners;
+  Corners out;
+  out.reserve(corners.size());
+  for (const auto& p : corners) out.emplace_back(p.x, p.y);
+  return out;
 }
 
-IntrinsicsResult calibrate_intrinsics(const std::vector<std::vector<cv::Point2f>>& corners, const Board& board,
-                                      cv::Size image_size) {
+IntrinsicsResult calibrate_intrinsics(const std::vector<Corners>& views, const Board& board, int width, int height) {
+  const cv::Size image_size(width, height);
+  std::vector<std::vector<cv::Point2f>> corners;
+  for (const auto& v : views) corners.push_back(points_of(v));
   if (corners.size() < 3) {
     throw CalibError("need the board in at least 3 images for intrinsics, found it in " + std::to_string(corners.size()));
   }
@@ -93,20 +143,22 @@ IntrinsicsResult calibrate_intrinsics(const std::vector<std::vector<cv::Point2f>
   return r;
 }
 
-LiftedCorners lift_corners(const std::vector<cv::Point2f>& corners, const cv::Mat& depth_mm, const Intrinsics& k,
-                           const Board& board) {
-  if (depth_mm.type() != CV_16U) throw CalibError("depth image must be 16-bit millimetres");
+LiftedCorners lift_corners(const Corners& corners, const DepthImageMm& depth, const Intrinsics& k, const Board& board) {
+  if (depth.mm.size() != static_cast<std::size_t>(depth.width) * static_cast<std::size_t>(depth.height)) {
+    throw CalibError("depth image: " + std::to_string(depth.mm.size()) + " readings for " + std::to_string(depth.width) + "x" +
+                     std::to_string(depth.height));
+  }
   if (corners.size() != static_cast<std::size_t>(board.cols * board.rows)) throw CalibError("corner count does not match the board");
   // The outline of the inner corners: the board is certainly there.
   const int c = board.cols, last = board.cols * board.rows - 1;
   std::vector<cv::Point> outline;
-  for (int i : {0, c - 1, last, last - c + 1}) outline.emplace_back(cvRound(corners[i].x), cvRound(corners[i].y));
-  cv::Mat mask = cv::Mat::zeros(depth_mm.size(), CV_8U);
+  for (int i : {0, c - 1, last, last - c + 1}) outline.emplace_back(cvRound(corners[i].x()), cvRound(corners[i].y()));
+  cv::Mat mask = cv::Mat::zeros(depth.height, depth.width, CV_8U);
   cv::fillConvexPoly(mask, outline, cv::Scalar(255));
   std::vector<Vector3d> pts;
-  for (int v = 0; v < depth_mm.rows; ++v) {
-    for (int u = 0; u < depth_mm.cols; ++u) {
-      const auto d = depth_mm.at<std::uint16_t>(v, u);
+  for (int v = 0; v < depth.height; ++v) {
+    for (int u = 0; u < depth.width; ++u) {
+      const auto d = depth.mm[static_cast<std::size_t>(v) * depth.width + u];
       if (d == 0 || mask.at<std::uint8_t>(v, u) == 0) continue;
       pts.push_back(k.ray(u, v) * (d / 1000.0));
     }
@@ -139,7 +191,7 @@ LiftedCorners lift_corners(const std::vector<cv::Point2f>& corners, const cv::Ma
   }
   out.depth_pixels = use.size();
   for (const auto& p : corners) {
-    const Vector3d r = k.ray(p.x, p.y);
+    const Vector3d r = k.ray(p.x(), p.y());
     const double den = normal.dot(r);
     if (std::abs(den) < 1e-9) throw CalibError("the board is seen edge-on");
     out.points.push_back(r * (normal.dot(centroid) / den));
@@ -176,19 +228,21 @@ BoardView render_board_view(const Board& board, const Intrinsics& k, const Eigen
   for (int r = 0; r < 3; ++r) {
     for (int c = 0; c < 3; ++c) Hcv.at<double>(r, c) = H(r, c);
   }
-  BoardView view;
-  cv::warpPerspective(tex, view.grey, Hcv, cv::Size(k.width, k.height), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
-                      cv::Scalar(110));
-  cv::GaussianBlur(view.grey, view.grey, cv::Size(0, 0), 0.7);
+  cv::Mat grey;
+  cv::warpPerspective(tex, grey, Hcv, cv::Size(k.width, k.height), cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(110));
+  cv::GaussianBlur(grey, grey, cv::Size(0, 0), 0.7);
   cv::RNG rng(seed);
-  cv::Mat noise(view.grey.size(), CV_32F);
+  cv::Mat noise(grey.size(), CV_32F);
   rng.fill(noise, cv::RNG::NORMAL, 0.0, grey_noise);
   cv::Mat g;
-  view.grey.convertTo(g, CV_32F);
+  grey.convertTo(g, CV_32F);
   g += noise;
-  g.convertTo(view.grey, CV_8U);
+  g.convertTo(grey, CV_8U);
+  BoardView view;
+  view.grey = grey_of(grey);
   // Depth: each pixel's ray cut with the board's plane, where it hits the board.
-  view.depth_mm = cv::Mat::zeros(k.height, k.width, CV_16U);
+  view.depth_mm.width = k.width, view.depth_mm.height = k.height;
+  view.depth_mm.mm.assign(static_cast<std::size_t>(k.width) * static_cast<std::size_t>(k.height), 0);
   const Vector3d n = R.col(2);
   const double lo_x = -(margin + 1) * board.square_m, hi_x = (board.cols + margin) * board.square_m;
   const double lo_y = -(margin + 1) * board.square_m, hi_y = (board.rows + margin) * board.square_m;
@@ -204,10 +258,47 @@ BoardView render_board_view(const Board& board, const Intrinsics& k, const Eigen
       const double z = lambda;  // d.z() == 1
       const double sd = depth_noise_scale * (0.0012 + 0.0019 * (z - 0.4) * (z - 0.4));
       const double mm = std::round((z + rng.gaussian(sd)) * 1000.0);
-      if (mm > 0 && mm < 65535) view.depth_mm.at<std::uint16_t>(v, u) = static_cast<std::uint16_t>(mm);
+      if (mm > 0 && mm < 65535) view.depth_mm.mm[static_cast<std::size_t>(v) * k.width + u] = static_cast<std::uint16_t>(mm);
     }
   }
   return view;
+}
+
+std::vector<std::string> board_view_names(const std::string& dir) {
+  std::vector<std::string> names;
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
+    const auto f = e.path().filename().string();
+    const std::string tail = "_color.png";
+    if (f.size() > tail.size() && f.compare(f.size() - tail.size(), tail.size(), tail) == 0) {
+      names.push_back(f.substr(0, f.size() - tail.size()));
+    }
+  }
+  if (ec) throw CalibError(dir + ": " + ec.message());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+std::optional<std::vector<Eigen::Vector3d>> lift_board_view(const std::string& dir, const std::string& name,
+                                                            const Board& board, const Intrinsics& k, std::string* why) {
+  const std::filesystem::path d = dir;
+  const auto colour = (d / (name + "_color.png")).string(), depth = (d / (name + "_depth.png")).string();
+  if (!std::filesystem::exists(colour) || !std::filesystem::exists(depth)) {
+    *why = name + ": no colour and depth image in " + dir;
+    return std::nullopt;
+  }
+  const auto corners = find_corners(read_grey_image(colour), board);
+  if (!corners) {
+    *why = name + ": board not found in " + colour;
+    return std::nullopt;
+  }
+  const auto depth_image = read_depth_image(depth);
+  try {
+    return lift_corners(*corners, depth_image, k, board).points;
+  } catch (const CalibError& e) {
+    *why = name + ": " + e.what();
+    return std::nullopt;
+  }
 }
 
 Eigen::Isometry3d camera_from_board(const Eigen::Isometry3d& world_from_sensor, const Eigen::Isometry3d& world_from_board) {

@@ -3,6 +3,7 @@
 // still gets them). A bad file fails the graph's start with file:line.
 
 #include "skelgraph/calib/calib_file.hpp"
+#include "skelgraph/skeleton/skeleton_msg.hpp"
 #include "skelgraph/runtime/component.hpp"
 #include "skelgraph/runtime/pubsub.hpp"
 #include "skelgraph/runtime/registry.hpp"

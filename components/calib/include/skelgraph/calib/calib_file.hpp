@@ -23,7 +23,7 @@
 
 #include "skelgraph/calib/intrinsics.hpp"
 #include "skelgraph/calib/robot_calib.hpp"
-#include "skelgraph/skeleton/skeleton_msg.hpp"
+#include "skelgraph/skeleton/skeleton.hpp"
 
 namespace skelgraph::calib {
 

@@ -18,7 +18,7 @@
 
 #include "skelgraph/runtime/rate_stats.hpp"
 #include "skelgraph/skeleton/skeleton.hpp"
-#include "skelgraph/skeleton/skeleton_msg.hpp"
+#include "skelgraph/skeleton/skeleton.hpp"
 
 namespace skelgraph::viewer {
 
