@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "skelgraph/depth_tracker/frame_matcher.hpp"
 #include "skelgraph/depth_tracker/sim_depth.hpp"
 #include "skelgraph/depth_tracker/tracker.hpp"
 #include "skelgraph/sim/body.hpp"
@@ -258,4 +259,35 @@ TEST(DepthTracker, AJointIsOnTheSurfaceItsPixelShows) {
   EXPECT_FALSE(depth_tracker::on_surface(img, depth::unproject(img.intrinsics, 5, 5, 1.5)));    // a pixel without a reading
   EXPECT_FALSE(depth_tracker::on_surface(img, depth::unproject(img.intrinsics, -20, 20, 1.5)));  // outside the image
   EXPECT_FALSE(depth_tracker::on_surface(img, Eigen::Vector3d(0, 0, -1)));                      // behind the sensor
+}
+
+// Merged views: the lead's frame comes out with every sensor's latest of the
+// same moment (within the window), in the sensors' order; others' frames
+// only wait; a frame older than the window is left out.
+TEST(FrameMatcher, TheLeadsFrameGathersEachSensorsLatestOfTheSameMoment) {
+  depth_tracker::FrameMatcher<std::string> m(40'000'000);
+  const auto image = [](int frame) {
+    auto img = depth::DepthImage::blank(depth::kinect_intrinsics(8, 6));
+    img.frame_number = static_cast<std::uint32_t>(frame);
+    return img;
+  };
+  const auto frames = [](const auto& views) {
+    std::vector<std::pair<std::string, int>> out;
+    for (const auto& v : views) out.emplace_back(v.sensor, static_cast<int>(v.image->frame_number));
+    return out;
+  };
+  using F = std::vector<std::pair<std::string, int>>;
+  EXPECT_EQ(frames(m.add("sensor2", 0, image(1))), (F{{"sensor2", 1}}));  // the first sensor seen leads
+  ASSERT_TRUE(m.lead());
+  EXPECT_EQ(*m.lead(), "sensor2");
+  EXPECT_TRUE(m.add("sensor1", 10'000'000, image(7)).empty());   // not the lead: kept
+  EXPECT_TRUE(m.add("sensor3", 15'000'000, image(9)).empty());
+  EXPECT_EQ(frames(m.add("sensor2", 33'000'000, image(2))), (F{{"sensor1", 7}, {"sensor2", 2}, {"sensor3", 9}}));
+  EXPECT_TRUE(m.add("sensor1", 40'000'000, image(8)).empty());
+  // Then: sensor3's frame (51 ms before) is of another moment, sensor1's newest (26 ms before) is not.
+  EXPECT_EQ(frames(m.add("sensor2", 66'000'000, image(3))), (F{{"sensor1", 8}, {"sensor2", 3}}));
+  // A lead given up front.
+  depth_tracker::FrameMatcher<std::size_t> by_index(40'000'000, std::size_t{0});
+  EXPECT_TRUE(by_index.add(1, 0, image(1)).empty());
+  EXPECT_EQ(by_index.add(0, 5'000'000, image(1)).size(), 2u);
 }

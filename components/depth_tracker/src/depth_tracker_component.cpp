@@ -95,19 +95,15 @@ void DepthTrackerComponent::on_depth_merged(depth::DepthImage image, std::int64_
       }
       return;
     }
-    if (lead_.empty()) lead_ = image.sensor_id;
-    const bool lead = image.sensor_id == lead_;
-    const std::string id = image.sensor_id;  // (the assignment below moves the image before it indexes)
-    ++sensors_[id].frames;
-    latest_[id] = {receive_ns, std::move(image)};
-    if (!lead) return;
+    ++sensors_[image.sensor_id].frames;
+    const auto views = moments_.add(image.sensor_id, receive_ns, std::move(image));
+    if (views.empty()) return;  // not the lead's frame
     // The lead's image with every other sensor's latest of the same moment (received within 40 ms).
     std::vector<depth::DepthImage> images;
     std::vector<Eigen::Isometry3d> poses;
-    for (const auto& [sensor, entry] : latest_) {
-      if (std::llabs(entry.first - receive_ns) > 40'000'000) continue;
-      images.push_back(entry.second);
-      poses.push_back(poses_.at(sensor));
+    for (const auto& v : views) {
+      images.push_back(*v.image);
+      poses.push_back(poses_.at(v.sensor));
     }
     const auto t0 = std::chrono::steady_clock::now();
     people = merged_->track_merged(images, poses, merged_id_);

@@ -1,5 +1,7 @@
 #include "skelgraph/depth_tracker/sim_depth.hpp"
 
+#include "skelgraph/depth_tracker/frame_matcher.hpp"
+
 #include <chrono>
 #include <cmath>
 #include <optional>
@@ -24,7 +26,7 @@ SimDepthResult track_simulated_depth(sim::SimConfig config, const SimDepthOption
   DepthTracker merged_tracker(options.tracker);
   std::vector<Eigen::Isometry3d> poses;
   for (const auto& s : config.sensors) poses.push_back(s.world_from_sensor());
-  std::vector<std::optional<std::pair<double, depth::DepthImage>>> latest(config.sensors.size());  // (world time, image)
+  FrameMatcher<std::size_t> moments(40'000'000, std::size_t{0});  // the first sensor's frames lead
   for (auto& e : sim.advance(sim.duration() + 1.0)) {
     const auto t_ns = config.epoch_ns + static_cast<std::int64_t>(std::llround(e.t * 1e9));
     if (e.kind == sim::SimEvent::Kind::Truth) {
@@ -41,16 +43,15 @@ SimDepthResult track_simulated_depth(sim::SimConfig config, const SimDepthOption
     if (!options.merged) {
       for (auto& s : trackers[e.sensor].track(image)) r.events.push_back({eval::TimedSkeleton::Kind::Raw, t_ns, std::move(s)});
     } else {
-      latest[e.sensor] = std::make_pair(e.t, std::move(image));
-      if (e.sensor == 0) {
-        std::vector<depth::DepthImage> views;
+      const auto views = moments.add(e.sensor, t_ns, std::move(image));
+      if (!views.empty()) {
+        std::vector<depth::DepthImage> images;
         std::vector<Eigen::Isometry3d> view_poses;
-        for (std::size_t i = 0; i < latest.size(); ++i) {
-          if (!latest[i] || e.t - latest[i]->first > 0.04) continue;  // a frame of this moment only
-          views.push_back(latest[i]->second);
-          view_poses.push_back(poses[i]);
+        for (const auto& v : views) {
+          images.push_back(*v.image);
+          view_poses.push_back(poses[v.sensor]);
         }
-        for (auto& s : merged_tracker.track_merged(views, view_poses)) {
+        for (auto& s : merged_tracker.track_merged(images, view_poses)) {
           r.events.push_back({eval::TimedSkeleton::Kind::Raw, t_ns, std::move(s)});
         }
       }

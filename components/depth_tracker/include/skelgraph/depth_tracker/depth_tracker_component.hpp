@@ -15,6 +15,7 @@
 #include <mutex>
 #include <string>
 
+#include "skelgraph/depth_tracker/frame_matcher.hpp"
 #include "skelgraph/depth_tracker/tracker.hpp"
 #include "skelgraph/runtime/component.hpp"
 #include "skelgraph/runtime/pubsub.hpp"
@@ -42,8 +43,7 @@ class DepthTrackerComponent final : public runtime::Component {
   TrackerOptions options_;
   bool merge_ = false;
   std::string merged_id_;
-  std::string lead_;  // merge: the sensor whose images trigger a fit
-  std::map<std::string, std::pair<std::int64_t, depth::DepthImage>> latest_;  // merge: receive time, image
+  FrameMatcher<std::string> moments_;  // merge: the first sensor's images trigger a fit, with the others' of that moment
   std::unique_ptr<DepthTracker> merged_;
   std::uint64_t merged_fits_ = 0, merged_skeletons_ = 0;
   double merged_s_ = 0.0;
