@@ -4,9 +4,9 @@
 // when it brings the sensors' skeletons closer on the data the fit saw (the
 // upper median of their joint distances), and never when the fit could not
 // tell on which side of the person the sensor is (undecided). `skelgraph
-// calib skeleton` (a pair, or the whole cell) and the drift component's
-// refined poses go through it. With a hold-out split (fit on the first half
-// in time, check on the second) a step is judged on data it did not see.
+// calib skeleton` (a pair, or the whole cell) goes through it. With a
+// hold-out split (fit on the first half in time, check on the second) a step
+// is judged on data it did not see.
 // The drift component's refined pose is not judged this way: it corrects a
 // pair's offset beyond its baseline, and on the simulator (a sensor moved
 // 5 cm) the raw distances on the pair's last window rose 11.0 -> 11.7 cm while
