@@ -438,6 +438,227 @@ VectorXd feature_spread(const std::vector<const Sequence*>& data, const VectorXd
   return var;
 }
 
+// Baum-Welch over many sequences in its three steps, as mlpack's HMM::Train
+// is laid out: initialise() the first model, expectation() of the counts
+// under the current one, maximisation() into new parameters. Every frame of
+// every sequence is stacked once, centred, as quadratic features (Q), so an
+// iteration's emissions are the one product Q C and its statistics Q^T R.
+class BaumWelch {
+ public:
+  BaumWelch(const std::vector<Sequence>& data, const TrainOptions& o, std::size_t frames)
+      : data_(data), o_(o), frames_(frames), N_(o.states), M_(o.mixtures), D_(data.front().cols()), rng_(o.seed) {
+    // Regularisation scaled to each feature's spread over all data. A feature
+    // that never varies takes the spread given (a classifier's, shared by its
+    // models) or the others' mean, so that a test frame off by a hair in it is
+    // not worth -1e12 (with a floor of 1e-12 it was).
+    if (o.constant_spread.size() != 0 && o.constant_spread.size() != D_)
+      throw ModelError("constant_spread has " + std::to_string(o.constant_spread.size()) + " values for " +
+                       std::to_string(D_) + "-dimensional data");
+    std::vector<const Sequence*> all_data;
+    for (const auto& x : data) all_data.push_back(&x);
+    const VectorXd spread = feature_spread(all_data, o.constant_spread, &mean_);
+    reg_ = o.regularisation * spread;
+    global_cov_ = MatrixXd(spread.asDiagonal());
+  }
+
+  // The first parameters. Init::Segments: each sequence cut into N equal
+  // parts, state j taking the j-th part of every sequence; Init::KMeans: a
+  // state per k-means cluster of all frames. Then k-means within a state for
+  // its mixtures; the transitions as the options' shape asks.
+  Hmm initialise() {
+    const int N = N_, M = M_;
+    const auto D = D_;
+    std::vector<std::vector<VectorXd>> by_state(static_cast<std::size_t>(N));
+    if (o_.init == Init::KMeans) {
+      std::vector<VectorXd> all;
+      all.reserve(frames_);
+      for (const auto& x : data_)
+        for (Eigen::Index t = 0; t < x.rows(); ++t) all.push_back(x.row(t).transpose());
+      const auto label = kmeans(all, N, rng_);
+      for (std::size_t i = 0; i < all.size(); ++i) by_state[static_cast<std::size_t>(label[i])].push_back(std::move(all[i]));
+    } else {
+      for (const auto& x : data_) {
+        for (Eigen::Index t = 0; t < x.rows(); ++t) {
+          by_state[static_cast<std::size_t>(t * N / x.rows())].push_back(x.row(t).transpose());
+        }
+      }
+    }
+    std::vector<GaussianMixture> em(static_cast<std::size_t>(N));
+    for (int j = 0; j < N; ++j) {
+      auto& pts = by_state[static_cast<std::size_t>(j)];
+      if (pts.empty()) pts.push_back(mean_);  // more states than frames in every sequence, or an empty k-means cluster
+      const auto label = kmeans(pts, M, rng_);
+      auto& g = em[static_cast<std::size_t>(j)];
+      g.weights = VectorXd::Zero(M);
+      for (int m = 0; m < M; ++m) {
+        VectorXd mu = VectorXd::Zero(D);
+        int cnt = 0;
+        for (std::size_t i = 0; i < pts.size(); ++i) {
+          if (label[i] == m) mu += pts[i], ++cnt;
+        }
+        MatrixXd cov = global_cov_;
+        if (cnt > 0) {
+          mu /= cnt;
+          if (cnt > 1) {
+            cov.setZero();
+            for (std::size_t i = 0; i < pts.size(); ++i) {
+              if (label[i] == m) cov += (pts[i] - mu) * (pts[i] - mu).transpose();
+            }
+            cov /= cnt;
+          }
+        } else {
+          mu = pts[std::uniform_int_distribution<std::size_t>(0, pts.size() - 1)(rng_)];
+        }
+        g.weights(m) = std::max(1.0, static_cast<double>(cnt));
+        g.means.push_back(mu);
+        g.covs.push_back(shape(cov, o_.covariance, reg_));
+      }
+      g.weights /= g.weights.sum();
+    }
+    VectorXd start = VectorXd::Zero(N);
+    MatrixXd trans = MatrixXd::Zero(N, N);
+    if (o_.left_right) {
+      start(0) = 1.0;
+      for (int i = 0; i < N; ++i) {
+        if (i + 1 < N) trans(i, i) = 0.6, trans(i, i + 1) = 0.4;
+        else trans(i, i) = 1.0;
+      }
+    } else if (o_.init == Init::KMeans) {
+      start.setConstant(1.0 / N);
+      trans.setConstant(1.0 / N);
+    } else {
+      start.setConstant(N > 1 ? 0.3 / (N - 1) : 1.0);
+      start(0) = N > 1 ? 0.7 : 1.0;
+      for (int i = 0; i < N; ++i) {
+        if (N == 1) {
+          trans(i, i) = 1.0;
+          continue;
+        }
+        trans.row(i).setConstant(0.1 / (N - 1));
+        trans(i, i) += 0.6;
+        trans(i, (i + 1) % N) += 0.3;
+        trans.row(i) /= trans.row(i).sum();
+      }
+    }
+    Hmm h(N, static_cast<int>(D), o_.covariance);
+    h.set(start, trans, em);
+    stack_frames();
+    return h;
+  }
+
+  // Forward-backward over every sequence under `h`: the posteriors and
+  // scaled recursions kept for maximisation(); the total log-likelihood.
+  double expectation(const Hmm& h) {
+    h.quadratic_coefficients(mean_, C_);
+    comp_.noalias() = Q_ * C_;
+    h.states_of(comp_, logb_);
+    double total = 0;
+    start_acc_ = VectorXd::Zero(N_);
+    for (std::size_t s = 0; s < data_.size(); ++s) {
+      const auto b = first_[s], T = first_[s + 1] - b;
+      const double ll = h.forward_backward(logb_.middleRows(b, T), B_.middleRows(b, T), alpha_.middleRows(b, T),
+                                           beta_.middleRows(b, T), scale_.segment(b, T), true);
+      if (!std::isfinite(ll)) {
+        throw ModelError("training: a sequence has zero likelihood under the model (a left-right model shorter than it needs?)");
+      }
+      total += ll;
+      start_acc_ += alpha_.row(b).cwiseProduct(beta_.row(b)).transpose();
+    }
+    return total;
+  }
+
+  // New parameters for `h` from the last expectation().
+  void maximisation(Hmm& h) {
+    const int N = N_, M = M_;
+    const auto F = static_cast<Eigen::Index>(frames_);
+    // State posteriors (rows of alpha .* beta sum to 1) and, for xi summed
+    // over time, A .* (alpha[t]^T * (B .* beta)[t+1] / c[t+1]) with no pair
+    // across two sequences (W is zero on every sequence's first frame).
+    const MatrixXd gamma = alpha_.cwiseProduct(beta_);
+    W_ = B_.cwiseProduct(beta_);
+    W_.array().colwise() /= scale_.array();
+    for (std::size_t s = 0; s < data_.size(); ++s) W_.row(first_[s]).setZero();
+    const MatrixXd trans_acc = h.trans_.cwiseProduct(alpha_.topRows(F - 1).transpose() * W_.bottomRows(F - 1));
+    // Each component's responsibility for each frame, then its weighted sums.
+    for (int j = 0; j < N; ++j) {
+      const auto off = h.offsets_[static_cast<std::size_t>(j)];
+      for (int m = 0; m < M; ++m) {
+        if (M == 1) R_.col(off) = gamma.col(j);
+        else R_.col(off + m) = gamma.col(j).cwiseProduct((comp_.col(off + m) - logb_.col(j)).array().exp().matrix());
+      }
+    }
+    const MatrixXd S = Q_.transpose() * R_;  // per component: sum r, sum r x, sum r x_a x_b
+    VectorXd new_start = start_acc_ / start_acc_.sum();
+    MatrixXd new_trans = h.transitions();
+    for (int i = 0; i < N; ++i) {
+      const double s = trans_acc.row(i).sum();
+      if (s > 1e-300) new_trans.row(i) = trans_acc.row(i) / s;
+    }
+    std::vector<GaussianMixture> new_em(static_cast<std::size_t>(N));
+    for (int j = 0; j < N; ++j) {
+      auto& g = new_em[static_cast<std::size_t>(j)];
+      const auto off = h.offsets_[static_cast<std::size_t>(j)];
+      g.weights = VectorXd::Zero(M);
+      for (int m = 0; m < M; ++m) {
+        const auto k = off + m;
+        const double n = S(0, k);
+        if (n < 1e-6) {
+          // A component nothing belongs to: start it again on a random frame.
+          const auto& x = data_[std::uniform_int_distribution<std::size_t>(0, data_.size() - 1)(rng_)];
+          g.means.push_back(x.row(std::uniform_int_distribution<Eigen::Index>(0, x.rows() - 1)(rng_)).transpose());
+          g.covs.push_back(shape(global_cov_, o_.covariance, reg_));
+          g.weights(m) = 1e-3;
+          continue;
+        }
+        VectorXd mu;
+        MatrixXd cov;
+        moments(S.col(k), D_, o_.covariance, mu, cov);
+        mu += mean_;
+        g.means.push_back(mu);
+        g.covs.push_back(shape(cov, o_.covariance, reg_));
+        g.weights(m) = n;
+      }
+      g.weights /= g.weights.sum();
+    }
+    h.set(new_start, new_trans, std::move(new_em));
+  }
+
+ private:
+  // Every frame of every sequence stacked once, centred, as quadratic
+  // features; the work matrices of the steps sized for them.
+  void stack_frames() {
+    const auto F = static_cast<Eigen::Index>(frames_);
+    const int K = N_ * M_;  // components of all states, in Pass::comp's column order
+    first_.assign(data_.size() + 1, 0);
+    {
+      MatrixXd xc(F, D_);
+      for (std::size_t s = 0; s < data_.size(); ++s) {
+        first_[s + 1] = first_[s] + data_[s].rows();
+        xc.middleRows(first_[s], data_[s].rows()) = data_[s].rowwise() - mean_.transpose();
+      }
+      Q_ = quadratic_features(xc, o_.covariance);
+    }
+    C_.resize(Q_.cols(), K);
+    R_.resize(F, K);
+    comp_.resize(F, K);
+    for (auto* m : {&logb_, &B_, &alpha_, &beta_, &W_}) m->resize(F, N_);
+    scale_.resize(F);
+  }
+
+  const std::vector<Sequence>& data_;
+  const TrainOptions& o_;
+  const std::size_t frames_;
+  const int N_, M_;
+  const Eigen::Index D_;
+  std::mt19937_64 rng_;
+  VectorXd mean_, reg_;
+  MatrixXd global_cov_;
+  std::vector<Eigen::Index> first_;  // each sequence's first row in the stacked frames
+  MatrixXd Q_, C_, R_;
+  Hmm::Pass::Rows comp_, logb_, B_, alpha_, beta_, W_;
+  VectorXd scale_, start_acc_;
+};
+
 Hmm Hmm::train(const std::vector<Sequence>& data, const TrainOptions& o, TrainReport* report) {
   if (data.empty()) throw ModelError("training: no sequences");
   if (o.states < 1 || o.mixtures < 1 || o.restarts < 1) throw ModelError("training: states, mixtures and restarts must be >= 1");
@@ -467,136 +688,12 @@ Hmm Hmm::train(const std::vector<Sequence>& data, const TrainOptions& o, TrainRe
     if (report) *report = best_report;
     return best;
   }
-  const int N = o.states, M = o.mixtures;
-  // Regularisation scaled to each feature's spread over all data. A feature
-  // that never varies takes the spread given (a classifier's, shared by its
-  // models) or the others' mean, so that a test frame off by a hair in it is
-  // not worth -1e12 (with a floor of 1e-12 it was).
-  if (o.constant_spread.size() != 0 && o.constant_spread.size() != D)
-    throw ModelError("constant_spread has " + std::to_string(o.constant_spread.size()) + " values for " +
-                     std::to_string(D) + "-dimensional data");
-  std::vector<const Sequence*> all_data;
-  for (const auto& x : data) all_data.push_back(&x);
-  VectorXd mean;
-  const VectorXd spread = feature_spread(all_data, o.constant_spread, &mean);
-  const VectorXd reg = o.regularisation * spread;
-  const MatrixXd global_cov = MatrixXd(spread.asDiagonal());
-
-  // Initialisation (Init::Segments): each sequence cut into N equal parts,
-  // state j taking the j-th part of every sequence; (Init::KMeans) a state
-  // per k-means cluster of all frames. Then k-means within a state for its mixtures.
-  std::mt19937_64 rng(o.seed);
-  std::vector<std::vector<VectorXd>> by_state(static_cast<std::size_t>(N));
-  if (o.init == Init::KMeans) {
-    std::vector<VectorXd> all;
-    all.reserve(frames);
-    for (const auto& x : data)
-      for (Eigen::Index t = 0; t < x.rows(); ++t) all.push_back(x.row(t).transpose());
-    const auto label = kmeans(all, N, rng);
-    for (std::size_t i = 0; i < all.size(); ++i) by_state[static_cast<std::size_t>(label[i])].push_back(std::move(all[i]));
-  } else {
-    for (const auto& x : data) {
-      for (Eigen::Index t = 0; t < x.rows(); ++t) {
-        by_state[static_cast<std::size_t>(t * N / x.rows())].push_back(x.row(t).transpose());
-      }
-    }
-  }
-  std::vector<GaussianMixture> em(static_cast<std::size_t>(N));
-  for (int j = 0; j < N; ++j) {
-    auto& pts = by_state[static_cast<std::size_t>(j)];
-    if (pts.empty()) pts.push_back(mean);  // more states than frames in every sequence, or an empty k-means cluster
-    const auto label = kmeans(pts, M, rng);
-    auto& g = em[static_cast<std::size_t>(j)];
-    g.weights = VectorXd::Zero(M);
-    for (int m = 0; m < M; ++m) {
-      VectorXd mu = VectorXd::Zero(D);
-      int cnt = 0;
-      for (std::size_t i = 0; i < pts.size(); ++i) {
-        if (label[i] == m) mu += pts[i], ++cnt;
-      }
-      MatrixXd cov = global_cov;
-      if (cnt > 0) {
-        mu /= cnt;
-        if (cnt > 1) {
-          cov.setZero();
-          for (std::size_t i = 0; i < pts.size(); ++i) {
-            if (label[i] == m) cov += (pts[i] - mu) * (pts[i] - mu).transpose();
-          }
-          cov /= cnt;
-        }
-      } else {
-        mu = pts[std::uniform_int_distribution<std::size_t>(0, pts.size() - 1)(rng)];
-      }
-      g.weights(m) = std::max(1.0, static_cast<double>(cnt));
-      g.means.push_back(mu);
-      g.covs.push_back(shape(cov, o.covariance, reg));
-    }
-    g.weights /= g.weights.sum();
-  }
-  VectorXd start = VectorXd::Zero(N);
-  MatrixXd trans = MatrixXd::Zero(N, N);
-  if (o.left_right) {
-    start(0) = 1.0;
-    for (int i = 0; i < N; ++i) {
-      if (i + 1 < N) trans(i, i) = 0.6, trans(i, i + 1) = 0.4;
-      else trans(i, i) = 1.0;
-    }
-  } else if (o.init == Init::KMeans) {
-    start.setConstant(1.0 / N);
-    trans.setConstant(1.0 / N);
-  } else {
-    start.setConstant(N > 1 ? 0.3 / (N - 1) : 1.0);
-    start(0) = N > 1 ? 0.7 : 1.0;
-    for (int i = 0; i < N; ++i) {
-      if (N == 1) {
-        trans(i, i) = 1.0;
-        continue;
-      }
-      trans.row(i).setConstant(0.1 / (N - 1));
-      trans(i, i) += 0.6;
-      trans(i, (i + 1) % N) += 0.3;
-      trans.row(i) /= trans.row(i).sum();
-    }
-  }
-  Hmm h(N, static_cast<int>(D), o.covariance);
-  h.set(start, trans, em);
-
-  // Every frame of every sequence stacked once, centred, as quadratic features.
-  const auto F = static_cast<Eigen::Index>(frames);
-  const int K = N * M;  // components of all states, in Pass::comp's column order
-  std::vector<Eigen::Index> first(data.size() + 1, 0);
-  MatrixXd Q;
-  {
-    MatrixXd xc(F, D);
-    for (std::size_t s = 0; s < data.size(); ++s) {
-      first[s + 1] = first[s] + data[s].rows();
-      xc.middleRows(first[s], data[s].rows()) = data[s].rowwise() - mean.transpose();
-    }
-    Q = quadratic_features(xc, o.covariance);
-  }
-  MatrixXd C(Q.cols(), K), R(F, K);
-  Pass::Rows comp(F, K), logb(F, N), B(F, N), alpha(F, N), beta(F, N), W(F, N);
-  VectorXd scale(F);
-
+  BaumWelch bw(data, o, frames);
+  Hmm h = bw.initialise();
   TrainReport rep;
   double previous = kNegInf;
   for (int iter = 0; iter <= o.max_iterations; ++iter) {
-    // E-step over every sequence with the current parameters.
-    h.quadratic_coefficients(mean, C);
-    comp.noalias() = Q * C;
-    h.states_of(comp, logb);
-    double total = 0;
-    VectorXd start_acc = VectorXd::Zero(N);
-    for (std::size_t s = 0; s < data.size(); ++s) {
-      const auto b = first[s], T = first[s + 1] - b;
-      const double ll = h.forward_backward(logb.middleRows(b, T), B.middleRows(b, T), alpha.middleRows(b, T),
-                                           beta.middleRows(b, T), scale.segment(b, T), true);
-      if (!std::isfinite(ll)) {
-        throw ModelError("training: a sequence has zero likelihood under the model (a left-right model shorter than it needs?)");
-      }
-      total += ll;
-      start_acc += alpha.row(b).cwiseProduct(beta.row(b)).transpose();
-    }
+    const double total = bw.expectation(h);
     rep.log_likelihood.push_back(total);
     const double gain = (total - previous) / static_cast<double>(frames);
     if (iter > 0 && gain < o.tolerance) {
@@ -606,57 +703,7 @@ Hmm Hmm::train(const std::vector<Sequence>& data, const TrainOptions& o, TrainRe
     if (iter == o.max_iterations) break;
     previous = total;
     rep.iterations = iter + 1;
-    // State posteriors (rows of alpha .* beta sum to 1) and, for xi summed
-    // over time, A .* (alpha[t]^T * (B .* beta)[t+1] / c[t+1]) with no pair
-    // across two sequences (W is zero on every sequence's first frame).
-    const MatrixXd gamma = alpha.cwiseProduct(beta);
-    W = B.cwiseProduct(beta);
-    W.array().colwise() /= scale.array();
-    for (std::size_t s = 0; s < data.size(); ++s) W.row(first[s]).setZero();
-    const MatrixXd trans_acc = h.trans_.cwiseProduct(alpha.topRows(F - 1).transpose() * W.bottomRows(F - 1));
-    // Each component's responsibility for each frame, then its weighted sums.
-    for (int j = 0; j < N; ++j) {
-      const auto off = h.offsets_[static_cast<std::size_t>(j)];
-      for (int m = 0; m < M; ++m) {
-        if (M == 1) R.col(off) = gamma.col(j);
-        else R.col(off + m) = gamma.col(j).cwiseProduct((comp.col(off + m) - logb.col(j)).array().exp().matrix());
-      }
-    }
-    const MatrixXd S = Q.transpose() * R;  // per component: sum r, sum r x, sum r x_a x_b
-    // M-step.
-    VectorXd new_start = start_acc / start_acc.sum();
-    MatrixXd new_trans = h.transitions();
-    for (int i = 0; i < N; ++i) {
-      const double s = trans_acc.row(i).sum();
-      if (s > 1e-300) new_trans.row(i) = trans_acc.row(i) / s;
-    }
-    std::vector<GaussianMixture> new_em(static_cast<std::size_t>(N));
-    for (int j = 0; j < N; ++j) {
-      auto& g = new_em[static_cast<std::size_t>(j)];
-      const auto off = h.offsets_[static_cast<std::size_t>(j)];
-      g.weights = VectorXd::Zero(M);
-      for (int m = 0; m < M; ++m) {
-        const auto k = off + m;
-        const double n = S(0, k);
-        if (n < 1e-6) {
-          // A component nothing belongs to: start it again on a random frame.
-          const auto& x = data[std::uniform_int_distribution<std::size_t>(0, data.size() - 1)(rng)];
-          g.means.push_back(x.row(std::uniform_int_distribution<Eigen::Index>(0, x.rows() - 1)(rng)).transpose());
-          g.covs.push_back(shape(global_cov, o.covariance, reg));
-          g.weights(m) = 1e-3;
-          continue;
-        }
-        VectorXd mu;
-        MatrixXd cov;
-        moments(S.col(k), D, o.covariance, mu, cov);
-        mu += mean;
-        g.means.push_back(mu);
-        g.covs.push_back(shape(cov, o.covariance, reg));
-        g.weights(m) = n;
-      }
-      g.weights /= g.weights.sum();
-    }
-    h.set(new_start, new_trans, std::move(new_em));
+    bw.maximisation(h);
   }
   if (report) *report = rep;
   return h;

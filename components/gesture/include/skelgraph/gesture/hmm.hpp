@@ -81,6 +81,8 @@ struct TrainReport {
   std::vector<double> log_likelihood;  // total over the sequences, after initialisation and after each iteration
 };
 
+class BaumWelch;
+
 class Hmm {
  public:
   Hmm() = default;
@@ -101,6 +103,8 @@ class Hmm {
   std::vector<int> viterbi(const Sequence& x, double* log_prob = nullptr) const;
   Eigen::MatrixXd posteriors(const Sequence& x) const;          // T x N, each row sums to 1
 
+  // Baum-Welch (hmm.cpp's BaumWelch: initialisation, then expectation and
+  // maximisation until the gain per frame falls below the tolerance).
   static Hmm train(const std::vector<Sequence>& data, const TrainOptions& options, TrainReport* report = nullptr);
 
   nlohmann::json to_json() const;
@@ -136,6 +140,7 @@ class Hmm {
   Pass pass(const Sequence& x, bool with_backward) const;
 
  private:
+  friend class BaumWelch;  // training's steps (hmm.cpp)
   // log w_m + log N_m per state's components (comp, T x sum of M) and log b_j (logb, T x N) for every frame of x.
   void emissions_of(const Eigen::MatrixXd& x, Eigen::Ref<Pass::Rows> comp, Eigen::Ref<Pass::Rows> logb) const;
   void states_of(const Eigen::Ref<const Pass::Rows>& comp, Eigen::Ref<Pass::Rows> logb) const;  // logb from comp
