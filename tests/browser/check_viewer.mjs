@@ -54,29 +54,38 @@ try {
   out.robots = { drawn: b.drawnRobots, text: await page.locator('#robots').innerText() };
   out.snapshots = snapshots;
 
+  // Waits (bounded) until what the page draws satisfies `pred`; a busy machine
+  // draws late, so the checks wait on the drawing, never on a fixed time.
+  const drawnUntil = async (pred, ms = 15000) => {
+    const t = Date.now();
+    let d = (await stats()).drawn;
+    while (!pred(d) && Date.now() - t < ms) {
+      await sleep(50);
+      d = (await stats()).drawn;
+    }
+    return d;
+  };
+
   // Layer toggle: hide the first sensor's skeleton.
   const before = (await stats()).drawn;
   const hidden = before.list.find((s) => s.kind === 'raw');
   if (hidden) {
+    const has = (d) => d.list.some((s) => s.stream === hidden.stream);
     await page.uncheck(`input[data-layer="${hidden.stream}"]`);
-    await sleep(300);
-    const after = (await stats()).drawn;
+    const after = await drawnUntil((d) => !has(d));
     out.toggle = { stream: hidden.stream, before: before.skeletons,
-                   after: after.skeletons, still_drawn: after.list.some((s) => s.stream === hidden.stream) };
+                   after: after.skeletons, still_drawn: has(after) };
     await page.check(`input[data-layer="${hidden.stream}"]`);
-    await sleep(300);
-    out.toggle.restored = (await stats()).drawn.list.some((s) => s.stream === hidden.stream);
+    out.toggle.restored = has(await drawnUntil(has));
   }
 
   // The uncertainty layer: each fused joint's 95 % sphere, hidden and shown again.
+  const spheres = (d) => d.list.reduce((n, s) => n + s.uncertainty, 0);
   const u0 = (await stats()).drawn;
   await page.uncheck('input[data-layer="uncertainty"]');
-  await sleep(300);
-  const u1 = (await stats()).drawn;
+  const u1 = await drawnUntil((d) => spheres(d) === 0);
   await page.check('input[data-layer="uncertainty"]');
-  await sleep(300);
-  const u2 = (await stats()).drawn;
-  const spheres = (d) => d.list.reduce((n, s) => n + s.uncertainty, 0);
+  const u2 = await drawnUntil((d) => spheres(d) > 0);
   out.uncertainty = { before: spheres(u0), hidden: spheres(u1), restored: spheres(u2) };
 
   // Pause freezes the view while frames keep arriving.
@@ -95,7 +104,9 @@ try {
 
   // A malformed request is answered with an error; the stream goes on.
   await page.evaluate(() => window.skelgraphSend('{"cmd":"rewind"}'));
-  await sleep(500);
+  await page.waitForFunction(() => window.skelgraphViewer.errors.length > 0, null, { timeout: 15000 }).catch(() => {});
+  await page.waitForFunction((n) => window.skelgraphViewer.framesReceived > n, p2.framesReceived,
+                             { timeout: 15000 }).catch(() => {});
   const e = await stats();
   out.malformed = { errors: e.errors, still_receiving: e.framesReceived > p2.framesReceived, connected: e.connected };
 
