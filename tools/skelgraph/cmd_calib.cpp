@@ -19,10 +19,10 @@
 #include "skelgraph/skeleton/stats.hpp"
 #include "skelgraph/calib/calib_file.hpp"
 #include "skelgraph/calib/calibration_step.hpp"
+#include "skelgraph/calib/inputs.hpp"
+#include "skelgraph/calib/sim_check.hpp"
 #include "skelgraph/calib/skeleton_calib.hpp"
 #include "skelgraph/eval/metrics.hpp"
-#include "skelgraph/mcap/mcap.hpp"
-#include "skelgraph/msg/cdr.hpp"
 #include "skelgraph/playback/readers.hpp"
 #include "skelgraph/robot/robot_component.hpp"
 #include "skelgraph/runtime/topics.hpp"
@@ -43,46 +43,16 @@ struct SkelOptions {
   int best_rigid_starts = 1;
 };
 
-// Each sensor's skeletons of one input, on one clock (a recording's log
-// time; a data set's stamps), and the poses the input already has.
-struct Input {
-  std::map<std::string, std::vector<calib::TimedSkeleton>> by_sensor;
-  std::map<std::string, Eigen::Isometry3d> poses;  // world_from_sensor, if recorded
-};
-
+// Each sensor's skeletons of one input (calib/inputs.hpp); a bad file is a usage error.
+using Input = calib::SkeletonInput;
 Input read_input(const std::string& path, const std::string& format, const std::string& on_error) {
-  Input in;
-  if (!format.empty()) {
-    playback::Recording rec;
-    playback::ReadOptions read;
-    read.on_error = on_error == "skip" ? playback::ReadOptions::OnError::Skip : playback::ReadOptions::OnError::Stop;
-    try {
-      rec = playback::read_recording(*playback::format_from_name(format), path, read);
-      note_skipped(rec);
-    } catch (const std::exception& e) {
-      throw UsageError(e.what());
-    }
-    for (const auto& s : rec.frames) in.by_sensor[s.sensor_id].push_back({s.stamp_ns, s});
-    return in;
-  }
   try {
-    const mcap::Reader reader(path);
-    reader.for_each_message([&](const mcap::Channel& ch, const mcap::Schema* schema, const mcap::Message& m) {
-      if (schema == nullptr) return;
-      const auto* bytes = reinterpret_cast<const std::uint8_t*>(m.data.data());
-      if (ch.topic == runtime::topics::kSkeletonRaw.name && schema->name == msg::MessageTraits<msg::Skeleton>::name) {
-        auto s = skeleton::from_msg(msg::from_cdr<msg::Skeleton>(bytes, m.data.size()));
-        in.by_sensor[s.sensor_id].push_back({static_cast<std::int64_t>(m.log_time), std::move(s)});
-      } else if (ch.topic == runtime::topics::kCalibration.name &&
-                 schema->name == msg::MessageTraits<msg::SensorPose>::name) {
-        const auto p = skeleton::from_msg(msg::from_cdr<msg::SensorPose>(bytes, m.data.size()));
-        if (p.frame_id == "world") in.poses[p.sensor_id] = p.pose;
-      }
-    });
-  } catch (const mcap::McapError& e) {
+    auto in = calib::read_skeleton_input(path, format, on_error == "skip");
+    if (!in.skipped_note.empty()) std::fprintf(stderr, "note: %s\n", in.skipped_note.c_str());
+    return in;
+  } catch (const calib::InputError& e) {
     throw UsageError(e.what());
   }
-  return in;
 }
 
 nlohmann::json pose_json(const Eigen::Isometry3d& T) {
@@ -449,12 +419,6 @@ struct SimCalibOptions {
   bool json = false, floor = false;
 };
 
-// How far an estimated pose is from the true one: rotation (degrees), translation (cm).
-std::pair<double, double> pose_error(const Eigen::Isometry3d& est, const Eigen::Isometry3d& truth) {
-  return {calib::rotation_angle_deg(est.linear() * truth.linear().transpose()),
-          100.0 * (est.translation() - truth.translation()).norm()};
-}
-
 nlohmann::json calib_sim_run(const SimCalibOptions& o, const std::string& layout, const std::string& scenario, int seed) {
   const auto colon = layout.find(':');
   if (colon == std::string::npos) throw UsageError("--layouts: '" + layout + "' is not LAYOUT:SENSORS, e.g. ring:3");
@@ -465,72 +429,43 @@ nlohmann::json calib_sim_run(const SimCalibOptions& o, const std::string& layout
                                          {"scenario", scenario, "--scenarios"},
                                          {"seed", std::to_string(seed), "--seeds"},
                                          {"repeats", "1000", "calib sim"}});
-  sim::Simulation simulation(cfg);
-  std::map<std::string, std::vector<calib::TimedSkeleton>> by_sensor;
-  for (auto& e : simulation.advance(o.seconds)) {
-    if (e.kind != sim::SimEvent::Kind::Raw) continue;
-    by_sensor[cfg.sensors[e.sensor].id].push_back({static_cast<std::int64_t>(std::llround(e.t * 1e9)), std::move(e.skeleton)});
-  }
-  const std::string ref = cfg.sensors.front().id;
-  const Eigen::Isometry3d world_from_ref = cfg.sensors.front().world_from_sensor();
+  const auto check = calib::check_cell_calibration(cfg, o.seconds, o.floor);
   nlohmann::json run{{"layout", name}, {"sensor_count", cfg.sensors.size()}, {"scenario", scenario}, {"seed", seed},
-                     {"seconds", o.seconds}, {"reference", ref}};
-  calib::CellCalibResult r;
-  try {
-    r = calib::calibrate_cell(by_sensor, ref);
-  } catch (const calib::CalibError& e) {
-    run["error"] = e.what();
+                     {"seconds", o.seconds}, {"reference", check.reference}};
+  if (!check.error.empty()) {
+    run["error"] = check.error;
     run["within_target"] = false;
     return run;
   }
-  double worst_deg = 0, worst_cm = 0;
-  bool all_placed = true;
   auto& sensors = run["sensors"] = nlohmann::json::array();
-  for (const auto& c : cfg.sensors) {
-    if (c.id == ref) continue;
-    const Eigen::Isometry3d truth = world_from_ref.inverse() * c.world_from_sensor();
-    const auto* s = r.sensor(c.id);
-    nlohmann::json j{{"sensor", c.id}, {"frames", by_sensor.count(c.id) ? by_sensor.at(c.id).size() : 0}};
-    if (s == nullptr || !s->placed) {
-      j["placed"] = false;
-      all_placed = false;
-      sensors.push_back(j);
-      continue;
-    }
-    const auto [deg, cm_off] = pose_error(s->reference_from_sensor, truth);
-    worst_deg = std::max(worst_deg, deg);
-    worst_cm = std::max(worst_cm, cm_off);
-    j["placed"] = true;
-    j["path"] = s->path;
-    j["ambiguous"] = s->ambiguous;
-    j["rotation_error_deg"] = deg;
-    j["translation_error_cm"] = cm_off;
-    j["median_distance_cm"] = json_number(cm(s->median_m));
-    // The same sensor calibrated directly against the reference alone (the pair method), for comparison.
-    for (const auto& l : r.links) {
-      if (l.a != ref || l.b != c.id) continue;
-      if (l.solved) {
-        const auto [d2, c2] = pose_error(l.fit.fit.transform(), truth);
-        j["pair_alone"] = {{"rotation_error_deg", d2}, {"translation_error_cm", c2}, {"mirrored_frames", l.fit.mirrored},
-                           {"matched_frames", l.fit.matched}, {"ambiguous", l.fit.ambiguous},
-                           {"inliers", l.fit.inliers}, {"turned_inliers", l.fit.turned_inliers}};
-      } else {
-        j["pair_alone"] = {{"error", l.error}};
+  for (const auto& s : check.sensors) {
+    nlohmann::json j{{"sensor", s.sensor}, {"frames", s.frames}, {"placed", s.placed}};
+    if (s.placed) {
+      j["path"] = s.fit.path;
+      j["ambiguous"] = s.fit.ambiguous;
+      j["rotation_error_deg"] = s.error.deg;
+      j["translation_error_cm"] = s.error.cm;
+      j["median_distance_cm"] = json_number(cm(s.fit.median_m));
+      if (s.pair && s.pair->solved) {
+        const auto& f = s.pair->fit;
+        j["pair_alone"] = {{"rotation_error_deg", s.pair_error.deg}, {"translation_error_cm", s.pair_error.cm},
+                           {"mirrored_frames", f.mirrored}, {"matched_frames", f.matched}, {"ambiguous", f.ambiguous},
+                           {"inliers", f.inliers}, {"turned_inliers", f.turned_inliers}};
+      } else if (s.pair) {
+        j["pair_alone"] = {{"error", s.pair->error}};
       }
-    }
-    if (o.floor && by_sensor.count(c.id)) {
-      // The floor: the rigid pose the skeletons themselves favour, searched from the truth (lowest median joint
-      // distance to the reference's skeletons); how far it is from the truth, no calibration from them can undo.
-      const auto low = calib::lowest_median_pose(by_sensor.at(ref), by_sensor.at(c.id), truth, 0, {}, 2.0);
-      const auto [fd, fc] = pose_error(low.reference_from_other, truth);
-      j["floor"] = {{"rotation_error_deg", fd}, {"translation_error_cm", fc}, {"median_cm", json_number(cm(low.median_m))},
-                    {"median_at_truth_cm", json_number(cm(low.start_median_m))}};
+      if (s.floor) {
+        // The floor: how far the pose the skeletons themselves favour is from the truth, which no calibration from them can undo.
+        j["floor"] = {{"rotation_error_deg", s.floor_error.deg}, {"translation_error_cm", s.floor_error.cm},
+                      {"median_cm", json_number(cm(s.floor->median_m))},
+                      {"median_at_truth_cm", json_number(cm(s.floor->start_median_m))}};
+      }
     }
     sensors.push_back(j);
   }
-  run["max_rotation_error_deg"] = worst_deg;
-  run["max_translation_error_cm"] = worst_cm;
-  run["within_target"] = all_placed && worst_deg <= o.target_deg && worst_cm <= o.target_cm;
+  run["max_rotation_error_deg"] = check.worst.deg;
+  run["max_translation_error_cm"] = check.worst.cm;
+  run["within_target"] = check.within(o.target_deg, o.target_cm);
   return run;
 }
 
@@ -851,49 +786,13 @@ struct RobotOptions {
   bool json = false;
 };
 
-// Hand at the tool: the recording's tool positions (robot/state, world) and
-// each sensor's hand joint (skeleton/raw, sensor frame), per sensor and
-// tracked person, on the recorder's clock (log time): the sensors' and the
-// robot's own stamps need not share a clock.
-struct HandInput {
-  std::vector<calib::TimedPoint> tool;
-  // sensor -> (person, hand) -> positions
-  std::map<std::string, std::map<std::pair<std::uint32_t, int>, std::vector<calib::TimedPoint>>> hands;
-  std::size_t states = 0;
-};
-
-HandInput read_hand_input(const std::string& path, const std::vector<skeleton::JointId>& joints) {
-  HandInput in;
+// The hand at the tool (calib/inputs.hpp); a bad recording is a usage error.
+calib::HandInput read_hand_input(const std::string& path, const std::vector<skeleton::JointId>& joints) {
   try {
-    const mcap::Reader reader(path);
-    reader.for_each_message([&](const mcap::Channel& ch, const mcap::Schema* schema, const mcap::Message& m) {
-      if (schema == nullptr) return;
-      const auto* bytes = reinterpret_cast<const std::uint8_t*>(m.data.data());
-      if (ch.topic == runtime::topics::kRobotState.name && schema->name == msg::MessageTraits<msg::RobotState>::name) {
-        const auto st = msg::from_cdr<msg::RobotState>(bytes, m.data.size());
-        const auto& p = st.tool_position();
-        in.tool.push_back({static_cast<std::int64_t>(m.log_time), {p.x(), p.y(), p.z()}});
-        ++in.states;
-      } else if (ch.topic == runtime::topics::kSkeletonRaw.name && schema->name == msg::MessageTraits<msg::Skeleton>::name) {
-        const auto s = skeleton::from_msg(msg::from_cdr<msg::Skeleton>(bytes, m.data.size()));
-        for (std::size_t k = 0; k < joints.size(); ++k) {
-          const auto& j = s[joints[k]];
-          if (j.confidence < 0.5f) continue;  // inferred: not where the hand is
-          in.hands[s.sensor_id][{s.person_id, static_cast<int>(k)}].push_back({static_cast<std::int64_t>(m.log_time), j.position});
-        }
-      }
-    });
-  } catch (const mcap::McapError& e) {
+    return calib::read_hand_input(path, joints);
+  } catch (const calib::InputError& e) {
     throw UsageError(e.what());
   }
-  const auto by_time = [](const calib::TimedPoint& a, const calib::TimedPoint& b) { return a.t_ns < b.t_ns; };
-  std::sort(in.tool.begin(), in.tool.end(), by_time);
-  for (auto& [s, people] : in.hands) {
-    for (auto& [id, pts] : people) std::sort(pts.begin(), pts.end(), by_time);
-  }
-  if (in.states == 0) throw UsageError(path + ": no skelgraph/robot/state messages (record the robot with the people)");
-  if (in.hands.empty()) throw UsageError(path + ": no skelgraph/skeleton/raw skeletons with a tracked hand");
-  return in;
 }
 
 int calib_robot(const RobotOptions& o) {
@@ -1070,9 +969,9 @@ int calib_robot(const RobotOptions& o) {
       j["places_agreeing"] = r.places_agreeing;
     }
     if (const auto t = truth.find(r.sensor); t != truth.end()) {
-      const auto [deg, cm_err] = pose_error(world_from_sensor, t->second);
-      j["error_deg"] = deg;
-      j["error_cm"] = cm_err;
+      const auto e = calib::pose_error(world_from_sensor, t->second);
+      j["error_deg"] = e.deg;
+      j["error_cm"] = e.cm;
     }
     sensors.push_back(j);
     skeleton::SensorPose p;
