@@ -24,7 +24,7 @@
 #include "cli.hpp"
 #include "demo_graph.hpp"
 #include "eval_sim.hpp"
-#include "report.hpp"
+#include "skelgraph/report/report.hpp"
 #include "skelgraph/eval/safety.hpp"
 #include "skelgraph/gesture/builtin_models.hpp"
 #include "skelgraph/gesture/sim_sessions.hpp"

@@ -25,7 +25,7 @@
 #include "eval_sim.hpp"
 #include "skelgraph/depth_tracker/sim_depth.hpp"
 #include "skelgraph/sim/sim_component.hpp"
-#include "report.hpp"
+#include "skelgraph/report/report.hpp"
 #include "run_graph.hpp"
 #include "skelgraph/calib/calib_file.hpp"
 #include "skelgraph/eval/offline.hpp"

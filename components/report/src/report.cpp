@@ -1,4 +1,4 @@
-#include "report.hpp"
+#include "skelgraph/report/report.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <limits>
 #include <sstream>
 
-namespace skelgraph::cli::report {
+namespace skelgraph::report {
 
 namespace {
 
@@ -163,4 +163,35 @@ std::string timeline(const std::string& title, const std::vector<Strip>& strips,
   return o.str();
 }
 
-}  // namespace skelgraph::cli::report
+std::string confusion_matrix(const std::string& title, const std::vector<std::string>& labels,
+                             const std::vector<std::vector<int>>& counts) {
+  const int K = static_cast<int>(labels.size()), cell = 56, left = 130, top = 120;
+  const int width = left + K * cell + 20, height = top + K * cell + 50;
+  std::ostringstream s;
+  s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << height
+    << "\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
+  s << "<text x=\"10\" y=\"20\" font-size=\"14\">" << html_escape(title) << "</text>\n";
+  s << "<text x=\"" << left + K * cell / 2 << "\" y=\"45\" text-anchor=\"middle\">predicted</text>\n";
+  s << "<text x=\"15\" y=\"" << top + K * cell / 2 << "\" transform=\"rotate(-90 15 " << top + K * cell / 2
+    << ")\" text-anchor=\"middle\">true</text>\n";
+  for (int i = 0; i < K; ++i) {
+    int row = 0;
+    for (int j = 0; j < K; ++j) row += counts[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)];
+    s << "<text x=\"" << left - 6 << "\" y=\"" << top + i * cell + cell / 2 + 4 << "\" text-anchor=\"end\">" << html_escape(labels[static_cast<std::size_t>(i)]) << "</text>\n";
+    const int x = left + i * cell + cell / 2;
+    s << "<text x=\"" << x << "\" y=\"" << top - 6 << "\" transform=\"rotate(-45 " << x << ' ' << top - 6 << ")\">" << html_escape(labels[static_cast<std::size_t>(i)]) << "</text>\n";
+    for (int j = 0; j < K; ++j) {
+      const int v = counts[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)];
+      const double share = row ? static_cast<double>(v) / row : 0.0;
+      const int shade = static_cast<int>(255 - 200 * share);
+      s << "<rect x=\"" << left + j * cell << "\" y=\"" << top + i * cell << "\" width=\"" << cell << "\" height=\"" << cell
+        << "\" fill=\"rgb(" << shade << ',' << shade << ",255)\" stroke=\"#888\"/>\n";
+      s << "<text x=\"" << left + j * cell + cell / 2 << "\" y=\"" << top + i * cell + cell / 2 + 4 << "\" text-anchor=\"middle\" fill=\""
+        << (share > 0.6 ? "white" : "black") << "\">" << v << "</text>\n";
+    }
+  }
+  s << "</svg>\n";
+  return s.str();
+}
+
+}  // namespace skelgraph::report

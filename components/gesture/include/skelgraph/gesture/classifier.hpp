@@ -2,44 +2,25 @@
 // Gesture classification with one HMM per class: highest likelihood wins,
 // an optional garbage class (everything that is not a gesture of interest,
 // as the thesis's two-class setup), and a rejection threshold below which the
-// answer is "no gesture". Cross-validation (stratified k-fold and
-// leave-subject-out), confusion matrices, per-class precision/recall/F1 and
-// ROC curves. Eigen and std only: no DDS.
+// answer is "no gesture". Class maps in class_map.hpp; confusion matrices,
+// per-class precision/recall/F1 and ROC curves in metrics.hpp;
+// cross-validation (stratified k-fold and leave-subject-out) in
+// cross_validation.hpp, included at the end of this file. Eigen and std only:
+// no DDS.
 
-#include <cstdint>
-#include <functional>
 #include <limits>
-#include <map>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "skelgraph/gesture/class_map.hpp"
 #include "skelgraph/gesture/features.hpp"
 #include "skelgraph/gesture/hmm.hpp"
+#include "skelgraph/gesture/metrics.hpp"
 
 namespace skelgraph::gesture {
-
-// Which recorded actions make which class. File (YAML):
-//   classes:            # in this order; each class lists the actions it takes
-//     point: [Point-at-the-camera]
-//   garbage: other      # optional: every unlisted action becomes this class
-// Without `garbage`, unlisted actions take part in no training; cross-validation
-// scores them as inputs that should be rejected.
-struct ClassMap {
-  std::vector<std::string> classes;                  // model order; the garbage class (if any) is last
-  std::map<std::string, std::string> action_class;   // action -> class
-  std::string garbage;                               // "" if none
-
-  static ClassMap preset(const std::string& name);   // "two-class", "five-class"; throws ModelError
-  static ClassMap load(const std::string& path);     // throws ModelError naming the file and field
-  static const std::vector<std::string>& preset_names();
-  // The class index of an action, or nullopt when it is not used.
-  std::optional<int> label_of(const std::string& action) const;
-  int garbage_index() const;  // -1 without a garbage class
-  nlohmann::json to_json() const;
-};
 
 // A model file's JSON; ModelError naming the file when it cannot be read or is not JSON.
 nlohmann::json read_model_json(const std::string& path);
@@ -78,18 +59,6 @@ struct ClassifierOptions {
   // of the longer clip). Classifier::train refuses it.
   bool nearest = false;
   double nearest_band = 0.2;
-};
-
-// Dynamic time warping: the Euclidean frame distances summed along the best
-// alignment within a band of `band` x the longer length (at least their
-// difference), divided by the two lengths' sum. +inf when either is empty.
-double dtw_distance(const Sequence& a, const Sequence& b, double band);
-
-struct Decision {
-  int label = -1;                 // the best class
-  bool rejected = false;          // its score is below the threshold: "no gesture"
-  std::vector<double> scores;     // per class: log-likelihood per frame
-  double margin = 0.0;            // best score minus the next best
 };
 
 // A constant correction of pointing rays, learnt against known targets
@@ -149,70 +118,8 @@ class Classifier {
   FeatureSet features_ = FeatureSet::Thesis8;
 };
 
-// --- Evaluation ---
-
-struct ClipResult {
-  std::size_t clip = 0;  // index into the clips
-  int truth = -1;
-  Decision decision;
-  int fold = 0;
-};
-
-struct RocPoint {
-  double threshold;
-  double tpr, fpr;
-};
-
-struct Metrics {
-  std::vector<std::string> labels;
-  std::vector<std::vector<int>> confusion;  // [truth][predicted], labelled clips only, no rejection
-  double accuracy = 0.0;                    // labelled clips, no rejection (the thesis's measure)
-  std::vector<double> precision, recall, f1;
-  // With rejection: labelled clips correctly classified and accepted; unlabelled ones rejected.
-  double accuracy_with_rejection = 0.0;
-  int rejected_labelled = 0, unlabelled = 0, unlabelled_rejected = 0;
-  // Detection of the first class: score = its log-likelihood per frame minus the best other's.
-  std::vector<RocPoint> detection_roc;
-  double detection_auc = 0.0;
-  // Rejection of unlabelled clips by the best score (empty without unlabelled clips).
-  std::vector<RocPoint> rejection_roc;
-  double rejection_auc = 0.0;
-};
-
-Metrics evaluate(const std::vector<ClipResult>& results, const std::vector<std::string>& labels);
-nlohmann::json to_json(const Metrics& m);
-std::string confusion_text(const Metrics& m);
-std::string confusion_svg(const Metrics& m, const std::string& title);
-
-// Body size: the subjects sorted by arm length (the median of their clips')
-// and cut in two halves; two folds: trained on the longer arms and tested on
-// the shorter, and the reverse.
-enum class Split { KFold, LeaveSubjectOut, BodySize };
-
-struct CvOptions {
-  Split split = Split::LeaveSubjectOut;
-  int folds = 5;             // k-fold: stratified by label
-  std::uint64_t seed = 1;
-};
-
-// Per-clip results from training on all folds but one, for every fold. `progress` (if set) is called after each fold.
-std::vector<ClipResult> cross_validate(const std::vector<Clip>& clips, const ClassMap& map, const ClassifierOptions& options,
-                                       const CvOptions& cv, const std::function<void(int done, int total)>& progress = {});
-
-// Whether `a` beats `b` when choosing a configuration: accuracy, then the first
-// class's F1, then the detection AUC.
-bool better(const Metrics& a, const Metrics& b);
-
-// Nested cross-validation, the honest figure for "try every configuration and
-// keep the best": in each outer fold, every configuration is cross-validated
-// (the same split) on that fold's training clips only, the best (`better`) is
-// trained on all of them and scores the held-out fold. Outer folds run in
-// parallel (the first configuration's `threads`).
-struct NestedCv {
-  std::vector<ClipResult> results;
-  std::vector<int> chosen;  // per outer fold: index into the configurations
-};
-NestedCv nested_cross_validate(const std::vector<Clip>& clips, const ClassMap& map, const std::vector<ClassifierOptions>& configs,
-                               const CvOptions& cv, const std::function<void(int done, int total)>& progress = {});
-
 }  // namespace skelgraph::gesture
+
+// Cross-validation (which needs the declarations above), for the files that
+// include only this header.
+#include "skelgraph/gesture/cross_validation.hpp"

@@ -1,11 +1,12 @@
 #pragma once
 // Self-contained figures and an HTML report (inline SVG, no scripts, no
-// network): what `skelgraph eval ... --report DIR` writes.
+// network): what `skelgraph eval ... --report DIR` writes, and the confusion
+// matrices of `skelgraph gesture cv --svg`. std only: no DDS.
 
 #include <string>
 #include <vector>
 
-namespace skelgraph::cli::report {
+namespace skelgraph::report {
 
 struct Series {
   std::string name;
@@ -25,6 +26,12 @@ struct Strip {
 std::string timeline(const std::string& title, const std::vector<Strip>& strips, int width = 760,
                      const std::string& legend = "green: reported at confidence 1; red: not");
 
+// A confusion matrix as a standalone SVG document: counts[truth][predicted],
+// a row and a column per label, each cell shaded by its share of its row.
+std::string confusion_matrix(const std::string& title, const std::vector<std::string>& labels,
+                             const std::vector<std::vector<int>>& counts);
+
+// The one escaping of text for HTML and SVG (text and attribute values): < > & ".
 std::string html_escape(const std::string& s);
 
-}  // namespace skelgraph::cli::report
+}  // namespace skelgraph::report
