@@ -286,6 +286,12 @@ TEST(FrameMatcher, TheLeadsFrameGathersEachSensorsLatestOfTheSameMoment) {
   EXPECT_TRUE(m.add("sensor1", 40'000'000, image(8)).empty());
   // Then: sensor3's frame (51 ms before) is of another moment, sensor1's newest (26 ms before) is not.
   EXPECT_EQ(frames(m.add("sensor2", 66'000'000, image(3))), (F{{"sensor1", 8}, {"sensor2", 3}}));
+  // The id taken from the image moved in, in the same call (as the component does).
+  depth_tracker::FrameMatcher<std::string> named(40'000'000);
+  auto img = image(5);
+  img.sensor_id = "sensor9";
+  EXPECT_EQ(frames(named.add(img.sensor_id, 0, std::move(img))), (F{{"sensor9", 5}}));
+  EXPECT_EQ(*named.lead(), "sensor9");
   // A lead given up front.
   depth_tracker::FrameMatcher<std::size_t> by_index(40'000'000, std::size_t{0});
   EXPECT_TRUE(by_index.add(1, 0, image(1)).empty());

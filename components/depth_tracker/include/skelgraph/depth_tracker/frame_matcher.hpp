@@ -30,8 +30,9 @@ class FrameMatcher {
       : window_ns_(window_ns), lead_(std::move(lead)) {}
 
   // Keeps the image as its sensor's latest. For the lead's frame, returns the
-  // moment's views; for another sensor's, nothing.
-  std::vector<View> add(const SensorId& sensor, std::int64_t t_ns, depth::DepthImage image) {
+  // moment's views; for another sensor's, nothing. (The id by value and the
+  // image by reference: `add(image.sensor_id, t, std::move(image))` is safe.)
+  std::vector<View> add(SensorId sensor, std::int64_t t_ns, depth::DepthImage&& image) {
     if (!lead_) lead_ = sensor;
     latest_[sensor] = {t_ns, std::move(image)};
     std::vector<View> views;
