@@ -13,6 +13,7 @@
 #include "skelgraph/msg/cdr.hpp"
 #include "skelgraph/playback/readers.hpp"
 #include "skelgraph/recording/bag.hpp"
+#include "skelgraph/recording/info.hpp"
 #include "skelgraph/recording/merge.hpp"
 #include "skelgraph/recording/session_recorder.hpp"
 #include "skelgraph/recording/tick_frames.hpp"
@@ -246,6 +247,58 @@ TEST(Merge, TwoHostsOntoTheMastersClockInOrder) {
     ADD_FAILURE() << "merged a file without a host";
   } catch (const recording::MergeError& e) {
     EXPECT_NE(std::string(e.what()).find("none.mcap"), std::string::npos) << e.what();
+  }
+  fs::remove_all(dir);
+}
+
+// What `bag info` reports (recording/info.hpp): ticks and sessions from the
+// sync topic, who acknowledged them, skeletons per sensor, counts per topic;
+// a file cut short is not valid and says where.
+TEST(RecordingInfo, TicksAcksSkeletonsAndADamagedFile) {
+  const auto dir = fs::temp_directory_path() / ("skelgraph_info_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const auto path = (dir / "r.mcap").string();
+  {
+    recording::BagWriter w(path);
+    w.write_metadata("session", {{"host", "h1"}});
+    for (int k = 0; k < 5; ++k) {
+      msg::SyncCommand tick;
+      tick.kind(msg::SYNC_TICK);
+      tick.session_id(3);
+      tick.tick(static_cast<std::uint64_t>(k));
+      w.write("skelgraph/sync", tick, 1000 + 100 * static_cast<std::uint64_t>(k), 0);
+      msg::SyncAck ack;
+      ack.session_id(3);
+      ack.tick(static_cast<std::uint64_t>(k));
+      ack.host("h1");
+      if (k < 4) w.write("skelgraph/sync_ack", ack, 1010 + 100 * static_cast<std::uint64_t>(k), 0);
+      msg::Skeleton s;
+      s.sensor_id(k % 2 ? "s2" : "s1");
+      w.write("skelgraph/skeleton/raw", s, 1050 + 100 * static_cast<std::uint64_t>(k), 0);
+    }
+    w.close();
+  }
+  const auto d = recording::recording_info(path);
+  EXPECT_TRUE(d["valid"].get<bool>()) << d["problem"];
+  EXPECT_EQ(d["ticks"], 5);
+  EXPECT_EQ(d["sessions"], nlohmann::json::array({3}));
+  EXPECT_EQ(d["messages"], 14);
+  EXPECT_EQ(d["skeletons_per_sensor"]["skelgraph/skeleton/raw s1"], 3);
+  EXPECT_EQ(d["skeletons_per_sensor"]["skelgraph/skeleton/raw s2"], 2);
+  EXPECT_FALSE(d["ticks_acked_by_host"].empty()) << d["ticks_acked_by_host"];
+  std::map<std::string, int> counts;
+  for (const auto& t : d["topics"]) counts[t["topic"].get<std::string>()] = t["count"].get<int>();
+  EXPECT_EQ(counts["skelgraph/sync_ack"], 4);
+  // Cut short in the middle of its data: read what is there, say why it is not valid.
+  const auto cut = (dir / "cut.mcap").string();
+  fs::copy_file(path, cut);
+  fs::resize_file(cut, fs::file_size(path) / 2);
+  try {
+    const auto c = recording::recording_info(cut);
+    EXPECT_FALSE(c["valid"].get<bool>());
+    EXPECT_FALSE(c["problem"].get<std::string>().empty());
+  } catch (const mcap::McapError& e) {
+    EXPECT_NE(std::string(e.what()).find("cut.mcap"), std::string::npos) << e.what();  // or unreadable, named
   }
   fs::remove_all(dir);
 }
