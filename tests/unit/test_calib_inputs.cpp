@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 
+#include "skelgraph/calib/calib_file.hpp"
 #include "skelgraph/calib/inputs.hpp"
 #include "skelgraph/calib/sim_check.hpp"
 #include "skelgraph/msg/messages.hpp"
@@ -135,4 +137,44 @@ TEST(CalibSimCheck, ASimulatedPairIsPlacedNearItsTruthAndComparedWithThePairAlon
   const auto e = calib::pose_error(Eigen::Isometry3d(Eigen::Translation3d(0.03, 0.04, 0)), Eigen::Isometry3d::Identity());
   EXPECT_NEAR(e.cm, 5.0, 1e-9);
   EXPECT_NEAR(e.deg, 0.0, 1e-9);
+}
+
+// bag import-bvh --transform: a rotation and translation, or a calibration
+// file's sensor; what is wrong named with the file.
+TEST(CalibFile, ATransformFromItsOwnFileOrACalibrationFile) {
+  const auto path = temp_path("transform.yaml");
+  const auto write = [&](const std::string& text) {
+    std::ofstream(path) << text;
+  };
+  write("rotation: [0, -1, 0, 1, 0, 0, 0, 0, 1]\ntranslation: [1, 2, 3]\n");
+  const auto t = calib::read_transform_file(path, "mocap");
+  EXPECT_TRUE(t.translation().isApprox(Eigen::Vector3d(1, 2, 3)));
+  EXPECT_TRUE((t.linear() * Eigen::Vector3d::UnitX()).isApprox(Eigen::Vector3d::UnitY()));
+  const auto message = [&](const std::string& text) {
+    write(text);
+    try {
+      calib::read_transform_file(path, "mocap");
+    } catch (const calib::CalibFileError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(message("rotation: [2, 0, 0, 0, 1, 0, 0, 0, 1]\ntranslation: [0, 0, 0]\n").find("is not a rotation"), std::string::npos);
+  EXPECT_NE(message("rotation: [1, 0, 0]\n").find("expected rotation"), std::string::npos);
+  EXPECT_NE(message("rotation: [a, 0, 0, 0, 1, 0, 0, 0, 1]\ntranslation: [0, 0, 0]\n").find(path), std::string::npos);
+  // A calibration file: its sensor "mocap" is the pose.
+  calib::CalibFile f;
+  skeleton::SensorPose p;
+  p.sensor_id = "mocap";
+  p.pose = Eigen::Translation3d(0, 0, 4) * Eigen::Isometry3d::Identity();
+  f.sensors.push_back(p);
+  calib::write_calib_file(path, f);
+  EXPECT_TRUE(calib::read_transform_file(path, "mocap").translation().isApprox(Eigen::Vector3d(0, 0, 4)));
+  try {
+    calib::read_transform_file(path, "vicon");
+    FAIL() << "a sensor the file does not have was found";
+  } catch (const calib::CalibFileError& e) {
+    EXPECT_NE(std::string(e.what()).find("no sensor 'vicon'"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove(path);
 }

@@ -11,7 +11,6 @@
 #include <set>
 #include <tuple>
 
-#include <yaml-cpp/yaml.h>
 
 #include <nlohmann/json.hpp>
 
@@ -124,48 +123,18 @@ struct MocapOptions {
   bool json = false;
 };
 
-// A rigid transform file (YAML): rotation: [9 numbers, row-major], translation: [x, y, z] metres;
-// or a calibration file, whose sensor `mocap_id` is the motion-capture system's pose in its frame.
-Eigen::Isometry3d read_transform(const std::string& path, const std::string& mocap_id) {
-  YAML::Node y;
-  try {
-    y = YAML::LoadFile(path);
-  } catch (const YAML::Exception& e) {
-    throw UsageError(path + ": not a readable YAML file: " + e.msg);
-  }
-  if (y["sensors"]) {
-    calib::CalibFile c;
-    try {
-      c = calib::read_calib_file(path);
-    } catch (const std::exception& e) {
-      throw UsageError(e.what());
-    }
-    std::string ids;
-    for (const auto& s : c.sensors) {
-      if (s.sensor_id == mocap_id) return s.pose;
-      ids += (ids.empty() ? "" : ", ") + s.sensor_id;
-    }
-    throw UsageError(path + ": no sensor '" + mocap_id + "' (the motion-capture system's pose; --mocap-id) among " + ids);
-  }
-  const auto r = y["rotation"], t = y["translation"];
-  if (!r || !r.IsSequence() || r.size() != 9 || !t || !t.IsSequence() || t.size() != 3)
-    throw UsageError(path + ": expected rotation: [9 numbers, row-major] and translation: [x, y, z] (metres)");
-  Eigen::Matrix3d m;
-  for (int i = 0; i < 9; ++i) m(i / 3, i % 3) = r[static_cast<std::size_t>(i)].as<double>();
-  if (!(m * m.transpose()).isApprox(Eigen::Matrix3d::Identity(), 1e-6) || m.determinant() < 0)
-    throw UsageError(path + ": the rotation is not a rotation (orthonormal, determinant 1)");
-  Eigen::Isometry3d iso = Eigen::Isometry3d::Identity();
-  iso.linear() = m;
-  iso.translation() = Eigen::Vector3d(t[0].as<double>(), t[1].as<double>(), t[2].as<double>());
-  return iso;
-}
-
 // Motion capture (BVH) as ground truth on skelgraph/skeleton/truth, alone or
 // added to a copy of a recording (so `eval recording` scores it against the mocap).
 int import_bvh(const MocapOptions& o) {
   playback::BvhOptions b;
   b.units_to_m = o.units == "mm" ? 0.001 : o.units == "m" ? 1.0 : o.units == "in" ? 0.0254 : 0.01;
-  if (!o.transform.empty()) b.target_from_mocap = read_transform(o.transform, o.mocap_id);
+  if (!o.transform.empty()) {
+    try {
+      b.target_from_mocap = calib::read_transform_file(o.transform, o.mocap_id);
+    } catch (const calib::CalibFileError& e) {
+      throw UsageError(e.what());
+    }
+  }
   if (!o.time_points.empty()) b.time_points = user_input([&] { return playback::read_bvh_time_points(o.time_points); });
   if (!o.mapping.empty()) b.joints = user_input([&] { return playback::read_bvh_mapping(o.mapping); });
   b.frame_id = o.frame_id;

@@ -262,4 +262,41 @@ void write_tool_poses(const std::string& path, const ToolPoses& t, const std::st
   save(path, e, comment);
 }
 
+Eigen::Isometry3d read_transform_file(const std::string& path, const std::string& sensor_id) {
+  YAML::Node y;
+  try {
+    y = YAML::LoadFile(path);
+  } catch (const YAML::Exception& e) {
+    throw CalibFileError(path + ": not a readable YAML file: " + e.msg);
+  }
+  if (y["sensors"]) {
+    const auto c = read_calib_file(path);
+    std::string ids;
+    for (const auto& s : c.sensors) {
+      if (s.sensor_id == sensor_id) return s.pose;
+      ids += (ids.empty() ? "" : ", ") + s.sensor_id;
+    }
+    throw CalibFileError(path + ": no sensor '" + sensor_id + "' (the motion-capture system's pose; --mocap-id) among " + ids);
+  }
+  const auto r = y["rotation"], t = y["translation"];
+  if (!r || !r.IsSequence() || r.size() != 9 || !t || !t.IsSequence() || t.size() != 3)
+    throw CalibFileError(path + ": expected rotation: [9 numbers, row-major] and translation: [x, y, z] (metres)");
+  Eigen::Matrix3d m;
+  try {
+    for (int i = 0; i < 9; ++i) m(i / 3, i % 3) = r[static_cast<std::size_t>(i)].as<double>();
+  } catch (const YAML::Exception& e) {
+    throw CalibFileError(path + ": rotation: " + e.msg);
+  }
+  if (!(m * m.transpose()).isApprox(Eigen::Matrix3d::Identity(), 1e-6) || m.determinant() < 0)
+    throw CalibFileError(path + ": the rotation is not a rotation (orthonormal, determinant 1)");
+  Eigen::Isometry3d iso = Eigen::Isometry3d::Identity();
+  iso.linear() = m;
+  try {
+    iso.translation() = Eigen::Vector3d(t[0].as<double>(), t[1].as<double>(), t[2].as<double>());
+  } catch (const YAML::Exception& e) {
+    throw CalibFileError(path + ": translation: " + e.msg);
+  }
+  return iso;
+}
+
 }  // namespace skelgraph::calib

@@ -78,4 +78,12 @@ void write_intrinsics_file(const std::string& path, const Intrinsics& k, double 
 ToolPoses read_tool_poses(const std::string& path);
 void write_tool_poses(const std::string& path, const ToolPoses& t, const std::string& comment);
 
+// A rigid transform from a file (`bag import-bvh --transform`): either
+//   rotation: [9 numbers, row-major]
+//   translation: [x, y, z]   # metres
+// or a calibration file, whose sensor `sensor_id` is the pose wanted (the
+// motion-capture system's in the file's frame). Throws CalibFileError naming
+// the file and what was wrong (not YAML, no such sensor, not a rotation).
+Eigen::Isometry3d read_transform_file(const std::string& path, const std::string& sensor_id);
+
 }  // namespace skelgraph::calib
