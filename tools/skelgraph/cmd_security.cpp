@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli.hpp"
+#include "skelgraph/runtime/security_policy.hpp"
 #include "skelgraph/runtime/topics.hpp"
 #include "skelgraph/viewer/access.hpp"
 
@@ -84,123 +85,14 @@ std::string utc(std::chrono::system_clock::time_point t) {
   return buf;
 }
 
-const std::vector<std::string> kRoles = {"master", "sensor", "reader", "robot", "robot-control"};
-
-// The robot's topics: only the robot host (its state) and the robot-control
-// hosts (commands, the safety verdict) may publish them; even the master not.
-std::vector<std::string> robot_topics() {
-  namespace t = runtime::topics;
-  return {t::kRobotState.name, t::kRobotCommand.name, t::kSafety.name};
-}
-
-// What a role may publish (every role may subscribe to everything).
-std::vector<std::string> role_publishes(const std::string& role) {
-  namespace t = runtime::topics;
-  if (role == "master") return {"*"};
-  if (role == "sensor") {
-    return {t::kSkeletonRaw.name, t::kSkeletonTruth.name, t::kSensorFrame.name, t::kCalibration.name,
-            t::kDepth.name,       t::kCloud.name,         t::kSyncAck.name,     t::kStatus.name,
-            t::kPlayState.name};
-  }
-  if (role == "robot") return {t::kRobotState.name, t::kSyncAck.name, t::kStatus.name};
-  if (role == "robot-control") return {t::kRobotCommand.name, t::kSafety.name, t::kSyncAck.name, t::kStatus.name};
-  return {t::kSyncAck.name, t::kStatus.name};  // reader
-}
-
-struct Grant {
-  std::vector<std::string> publish;  // allowed ("*": everything not denied)
-  std::vector<std::string> deny;     // denied first (a deny rule before the allow rule)
-};
-
-// A host's grant from its roles: the union of what they publish; a master
-// ("*") is denied the robot topics its other roles do not give it.
-Grant grant_of(const std::vector<std::string>& roles) {
-  Grant g;
-  std::set<std::string> seen;
-  for (const auto& r : roles)
-    for (const auto& t : role_publishes(r))
-      if (seen.insert(t).second) g.publish.push_back(t);
-  if (seen.count("*")) {
-    for (const auto& t : robot_topics())
-      if (!seen.count(t)) g.deny.push_back(t);
-  }
-  return g;
-}
-
 std::string joined(const std::vector<std::string>& v, const char* sep = "+") {
   std::string out;
   for (const auto& s : v) out += (out.empty() ? "" : sep) + s;
   return out;
 }
 
-const char* kDomains = "<domains><id_range><min>0</min><max>232</max></id_range></domains>";
 
-std::string governance_xml() {
-  return std::string(R"(<?xml version="1.0" encoding="UTF-8"?>
-<!-- skelgraph cell governance (skelgraph security init): only authenticated
-     participants join; discovery, liveliness and all RTPS traffic encrypted;
-     every topic under read and write access control. -->
-<dds xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance" xsi:noNamespaceSchemaLocation="http://www.omg.org/spec/DDS-SECURITY/20170901/omg_shared_ca_governance.xsd">
-  <domain_access_rules>
-    <domain_rule>
-      )") + kDomains + R"(
-      <allow_unauthenticated_participants>false</allow_unauthenticated_participants>
-      <enable_join_access_control>true</enable_join_access_control>
-      <discovery_protection_kind>ENCRYPT</discovery_protection_kind>
-      <liveliness_protection_kind>ENCRYPT</liveliness_protection_kind>
-      <rtps_protection_kind>ENCRYPT</rtps_protection_kind>
-      <topic_access_rules>
-        <topic_rule>
-          <topic_expression>*</topic_expression>
-          <enable_discovery_protection>true</enable_discovery_protection>
-          <enable_liveliness_protection>true</enable_liveliness_protection>
-          <enable_read_access_control>true</enable_read_access_control>
-          <enable_write_access_control>true</enable_write_access_control>
-          <metadata_protection_kind>ENCRYPT</metadata_protection_kind>
-          <data_protection_kind>ENCRYPT</data_protection_kind>
-        </topic_rule>
-      </topic_access_rules>
-    </domain_rule>
-  </domain_access_rules>
-</dds>
-)";
-}
-
-using Hosts = std::vector<std::pair<std::string, std::vector<std::string>>>;  // host, roles
-
-std::string permissions_xml(const Hosts& hosts, const std::string& from, const std::string& until) {
-  std::ostringstream x;
-  x << R"(<?xml version="1.0" encoding="UTF-8"?>
-<!-- skelgraph cell permissions (skelgraph security init): the sync master host
-     may publish everything but the robot's topics; sensor hosts their sensors'
-     topics; the robot host its state; robot-control hosts robot commands and
-     the safety verdict; reader hosts only acks and status. Every host may
-     subscribe to everything. -->
-<dds xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance" xsi:noNamespaceSchemaLocation="http://www.omg.org/spec/DDS-SECURITY/20170901/omg_shared_ca_permissions.xsd">
-  <permissions>
-)";
-  for (const auto& [host, roles] : hosts) {
-    const auto g = grant_of(roles);
-    x << "    <grant name=\"" << host << "\">\n"
-      << "      <subject_name>CN=" << host << "</subject_name>\n"
-      << "      <validity><not_before>" << from << "</not_before><not_after>" << until << "</not_after></validity>\n";
-    if (!g.deny.empty()) {
-      x << "      <deny_rule>\n        " << kDomains << "\n        <publish><topics>";
-      for (const auto& t : g.deny) x << "<topic>" << t << "</topic>";
-      x << "</topics></publish>\n      </deny_rule>\n";
-    }
-    x << "      <allow_rule>\n        " << kDomains << "\n        <publish><topics>";
-    for (const auto& t : g.publish) x << "<topic>" << t << "</topic>";
-    x << "</topics></publish>\n        <subscribe><topics><topic>*</topic></topics></subscribe>\n"
-      << "      </allow_rule>\n      <default>DENY</default>\n    </grant>\n";
-  }
-  x << "  </permissions>\n</dds>\n";
-  return x.str();
-}
-
-bool valid_host(const std::string& h) {
-  return !h.empty() && h.size() <= 64 && h.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_.") == std::string::npos;
-}
+using namespace runtime::security;
 
 struct InitOpts {
   std::string dir;
