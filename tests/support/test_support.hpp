@@ -9,6 +9,10 @@
 #include <mutex>
 #include <vector>
 
+#include <string>
+#include <thread>
+
+#include "skelgraph/runtime/context.hpp"
 #include "skelgraph/runtime/dds_config.hpp"
 
 namespace skelgraph::test {
@@ -18,6 +22,25 @@ inline runtime::DdsConfig test_config() {
   auto c = runtime::DdsConfig::from_env();
   c.profile = "loopback";
   return c;
+}
+
+// Waits until the component of `ctx` has taken `n` samples of `topic` (its
+// input counter): a test paces a stream by what the component has read, so a
+// component slower than the test on a busy machine loses nothing to its
+// reader's keep-last history.
+inline bool wait_input_count(const runtime::Context& ctx, const std::string& topic, std::uint64_t n,
+                             std::chrono::milliseconds timeout = std::chrono::seconds(10)) {
+  std::shared_ptr<runtime::EndpointCounter> input;
+  for (const auto& c : ctx.counters()) {
+    if (!c->is_output && c->topic == topic) input = c;
+  }
+  if (!input) return false;
+  const auto until = std::chrono::steady_clock::now() + timeout;
+  while (input->count.load() < n) {
+    if (std::chrono::steady_clock::now() > until) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));  // polling the condition
+  }
+  return true;
 }
 
 template <class T>
