@@ -12,7 +12,7 @@ using K = PlayGate::Kind;
 TEST(PlayGate, RunningPlayersDeliverUntilPaused) {
   PlayGate g(1.0);
   EXPECT_TRUE(g.may_deliver());
-  EXPECT_FALSE(g.delivered());
+  EXPECT_FALSE(g.delivered(false));
   EXPECT_EQ(g.apply(K::Pause), "");
   EXPECT_FALSE(g.may_deliver());
   EXPECT_FALSE(g.take_repace());  // pausing needs no new pacing; resuming does
@@ -30,7 +30,7 @@ TEST(PlayGate, StepsLetThatManyFramesThroughThenPauseAgain) {
   bool finished = false;
   while (g.may_deliver() && delivered < 10) {
     ++delivered;
-    finished = g.delivered();
+    finished = g.delivered(g.paused());
   }
   EXPECT_EQ(delivered, 3);
   EXPECT_TRUE(finished);  // the third frame finished the request
@@ -45,8 +45,18 @@ TEST(PlayGate, StepsLetThatManyFramesThroughThenPauseAgain) {
   running.apply(K::Step, 1);
   EXPECT_TRUE(running.paused());
   EXPECT_TRUE(running.may_deliver());
-  EXPECT_TRUE(running.delivered());
+  EXPECT_TRUE(running.delivered(true));
   EXPECT_FALSE(running.may_deliver());
+  // A frame let through while running, reported after a step came (a slow
+  // player), is not one of the step's frames.
+  PlayGate slow(1.0);
+  ASSERT_TRUE(slow.may_deliver() && !slow.paused());  // granted running
+  slow.apply(K::Pause);
+  slow.apply(K::Step, 2);
+  EXPECT_FALSE(slow.delivered(false));
+  EXPECT_EQ(slow.steps_left(), 2u);
+  EXPECT_FALSE(slow.delivered(true));
+  EXPECT_TRUE(slow.delivered(true));
 }
 
 TEST(PlayGate, SpeedChangesRestartPacingAndBadRequestsAreRefused) {

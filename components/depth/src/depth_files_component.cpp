@@ -166,7 +166,7 @@ void DepthFilesComponent::run() {
         ++published_;
         position_ = i;
       }
-      player_->delivered();
+      player_->delivered(stepping);
     }
     finished_ = true;
     ctx_.set_health(runtime::HealthState::Ok, "end of the images");

@@ -124,10 +124,12 @@ void OpenNI2Component::run() {
           recording_session_ = *want;
         }
       }
+      bool stepped = false;
       if (player_) {
         // A player: wait while paused; steps come without waiting; a new speed
         // or a resume paces afresh from the next frame.
         const auto [deliver, repace, stepping, speed] = player_->turn();
+        stepped = stepping;
         if (!deliver) {
           player_->wait_for_request(std::chrono::milliseconds(5));
           continue;
@@ -141,7 +143,7 @@ void OpenNI2Component::run() {
           std::lock_guard<std::mutex> lock(mutex_);
           ++published_;
         }
-        if (player_) player_->delivered();
+        if (player_) player_->delivered(stepped);
       } else if (source_->at_end()) {
         finished_ = true;
         ctx_.set_health(runtime::HealthState::Ok, "end of recording");

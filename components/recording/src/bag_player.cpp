@@ -189,7 +189,7 @@ void BagPlayer::check_stop_and_seek() {
   }
 }
 
-void BagPlayer::wait_until_due(std::uint64_t log_time) {
+bool BagPlayer::wait_until_due(std::uint64_t log_time) {
   for (;;) {
     check_stop_and_seek();
     const auto [deliver, repace, stepping, speed] = player_->turn();
@@ -202,9 +202,9 @@ void BagPlayer::wait_until_due(std::uint64_t log_time) {
       pace_mono_ = now;
       pace_log_ = log_time;
     }
-    if (stepping || speed <= 0.0) return;  // steps, and speed 0, do not wait
+    if (stepping || speed <= 0.0) return stepping;  // steps, and speed 0, do not wait
     const auto due = pace_mono_ + static_cast<std::int64_t>(static_cast<double>(log_time - pace_log_) / speed);
-    if (now >= due) return;
+    if (now >= due) return false;
     player_->wait_for_request(std::chrono::nanoseconds(std::min<std::int64_t>(due - now, 50'000'000)));
   }
 }
@@ -227,7 +227,7 @@ void BagPlayer::play_once(std::uint64_t from) {
       if (publisher_is_state_[p.publisher]) publishers_[p.publisher]->publish(p.sample);
       return;
     }
-    wait_until_due(t);
+    const bool stepped = wait_until_due(t);
     if (publishers_[p.publisher]->publish(p.sample, static_cast<std::int64_t>(t))) ++published_;
     else ++failed_;
     if (t - last_idle_check_ >= 100'000'000) {
@@ -235,7 +235,7 @@ void BagPlayer::play_once(std::uint64_t from) {
       dispose_idle(static_cast<std::int64_t>(t) - gone_after_ns_);
     }
     position_log_ = t;
-    player_->delivered();
+    player_->delivered(stepped);
     const auto now = ctx_.clock().monotonic_ns();
     if (now - last_state_ns_ >= 250'000'000) {
       last_state_ns_ = now;

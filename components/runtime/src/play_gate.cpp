@@ -47,8 +47,8 @@ std::string PlayGate::apply(Kind kind, double value) {
   return "unknown request";
 }
 
-bool PlayGate::delivered() {
-  if (!paused_ || steps_ == 0) return false;
+bool PlayGate::delivered(bool stepped) {
+  if (!stepped || !paused_ || steps_ == 0) return false;
   return --steps_ == 0;
 }
 

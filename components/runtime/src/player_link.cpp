@@ -62,11 +62,11 @@ void PlayerLink::wait_for_request(std::chrono::nanoseconds timeout) {
   cv_.wait_for(lock, timeout, [&] { return requests_ != seen; });
 }
 
-void PlayerLink::delivered() {
+void PlayerLink::delivered(bool stepped) {
   std::string answer;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (gate_.delivered()) answer = std::exchange(step_request_, "");
+    if (gate_.delivered(stepped)) answer = std::exchange(step_request_, "");
   }
   if (!answer.empty()) publish_state(answer, "");
 }

@@ -59,7 +59,7 @@ class BagPlayer final : public runtime::Component {
   void dispose_idle(std::int64_t before_log_ns);
   // Sleeps until `log_time` is due on the playback clock (paused: until resumed or
   // stepped); throws Stopped when asked to stop, SeekTo when asked to seek.
-  void wait_until_due(std::uint64_t log_time);
+  bool wait_until_due(std::uint64_t log_time);  // true: let through as a step
   void check_stop_and_seek();
   runtime::PlayerLink::Progress progress() const;
 

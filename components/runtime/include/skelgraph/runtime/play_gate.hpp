@@ -29,8 +29,11 @@ class PlayGate {
   std::optional<double> take_seek();
 
   bool may_deliver() const { return !paused_ || steps_ > 0; }
-  // After each delivered frame: true when it was the last of a step request.
-  bool delivered();
+  // After each delivered frame, saying whether it was let through as a step
+  // (paused() when the player asked): true when it was the last of a step
+  // request. A frame let through before a pause or a step (its player was
+  // slow to report it) does not count against the step.
+  bool delivered(bool stepped);
   // True once after a change from which pacing starts afresh (resume, speed, step).
   bool take_repace();
 

@@ -52,8 +52,9 @@ class PlayerLink {
   }
   // Waits until a request arrives or `timeout` passes (a paused player's sleep).
   void wait_for_request(std::chrono::nanoseconds timeout);
-  // After each delivered frame: answers a step request whose frames are out.
-  void delivered();
+  // After each delivered frame (`stepped`: its turn said stepping): answers a
+  // step request whose frames are out.
+  void delivered(bool stepped);
   // At the end of the recording: answers a step request that cannot finish.
   void at_end();
   // After the player has gone to a seek's position: answers the seek requests taken.
