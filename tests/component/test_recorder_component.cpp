@@ -99,6 +99,8 @@ TEST(RecorderComponent, RecordsASyncSessionAndAcknowledgesEveryTick) {
     clock->advance(33'000'000);
   }
   ASSERT_TRUE(acks.wait_count(5, 10s));
+  // The recorder records its own acks too: all five in before STOP (linger 0 closes at once).
+  ASSERT_TRUE(test::wait_input_count(rec_ctx, topics::kSyncAck.name, 5));
   const auto path = dir / "cell_3_h1.mcap";
   ASSERT_TRUE(sync.publish(sync_command(msg::SYNC_STOP, 5, clock->now_ns())));
   // Closed at STOP (linger 0), before any shutdown: the status says so.

@@ -24,23 +24,28 @@ inline runtime::DdsConfig test_config() {
   return c;
 }
 
-// Waits until the component of `ctx` has taken `n` samples of `topic` (its
-// input counter): a test paces a stream by what the component has read, so a
-// component slower than the test on a busy machine loses nothing to its
-// reader's keep-last history.
-inline bool wait_input_count(const runtime::Context& ctx, const std::string& topic, std::uint64_t n,
-                             std::chrono::milliseconds timeout = std::chrono::seconds(10)) {
-  std::shared_ptr<runtime::EndpointCounter> input;
+// Waits until the component of `ctx` has taken (an input) or written (an
+// output) `n` samples of `topic`, by its endpoint counter: a test paces a
+// stream by what the component has read, so a component slower than the test
+// on a busy machine loses nothing to its reader's keep-last history.
+enum class Endpoint { Input, Output };
+inline bool wait_endpoint_count(const runtime::Context& ctx, Endpoint which, const std::string& topic, std::uint64_t n,
+                                std::chrono::milliseconds timeout = std::chrono::seconds(10)) {
+  std::shared_ptr<runtime::EndpointCounter> counter;
   for (const auto& c : ctx.counters()) {
-    if (!c->is_output && c->topic == topic) input = c;
+    if (c->is_output == (which == Endpoint::Output) && c->topic == topic) counter = c;
   }
-  if (!input) return false;
+  if (!counter) return false;
   const auto until = std::chrono::steady_clock::now() + timeout;
-  while (input->count.load() < n) {
+  while (counter->count.load() < n) {
     if (std::chrono::steady_clock::now() > until) return false;
     std::this_thread::sleep_for(std::chrono::milliseconds(1));  // polling the condition
   }
   return true;
+}
+inline bool wait_input_count(const runtime::Context& ctx, const std::string& topic, std::uint64_t n,
+                             std::chrono::milliseconds timeout = std::chrono::seconds(10)) {
+  return wait_endpoint_count(ctx, Endpoint::Input, topic, n, timeout);
 }
 
 template <class T>
