@@ -14,6 +14,15 @@ Eigen::Isometry3d SensorConfig::world_from_sensor() const {
   return t;
 }
 
+skeleton::SensorPose SensorConfig::true_pose(std::int64_t stamp_ns) const {
+  skeleton::SensorPose p;
+  p.sensor_id = id;
+  p.pose = world_from_sensor();
+  p.stamp_ns = stamp_ns;
+  p.method = "ground_truth";
+  return p;
+}
+
 std::vector<SensorConfig> default_sensors(int count, double distance) {
   if (count < 1 || count > 16) throw std::invalid_argument("sensor count must be 1-16");
   static const double offsets_ms[] = {0.0, 12.0, -7.0, 20.0};

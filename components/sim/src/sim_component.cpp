@@ -153,13 +153,7 @@ void SimComponent::publish_poses() {
   if (!publish_poses_) return;
   for (std::size_t i = 0; i < config_.sensors.size(); ++i) {
     if (!publishes(i)) continue;
-    const auto& s = config_.sensors[i];
-    skeleton::SensorPose p;
-    p.sensor_id = s.id;
-    p.pose = s.world_from_sensor();
-    p.stamp_ns = config_.epoch_ns;
-    p.method = "ground_truth";
-    pose_pub_.publish(skeleton::to_msg(p));
+    pose_pub_.publish(skeleton::to_msg(config_.sensors[i].true_pose(config_.epoch_ns)));
   }
 }
 

@@ -12,6 +12,7 @@
 
 #include "skelgraph/sim/rng.hpp"
 #include "skelgraph/sim/scenario.hpp"
+#include "skelgraph/skeleton/skeleton.hpp"
 
 namespace skelgraph::sim {
 
@@ -29,6 +30,8 @@ struct SensorConfig {
   double clock_drift_ppm = 0.0;
 
   Eigen::Isometry3d world_from_sensor() const;
+  // Its true pose as a calibration says it (method ground_truth), stamped `stamp_ns`.
+  skeleton::SensorPose true_pose(std::int64_t stamp_ns = 0) const;
 };
 
 // `count` sensors 90 degrees apart around the cell centre, `distance` m from
