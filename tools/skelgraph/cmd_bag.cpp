@@ -1,54 +1,23 @@
-// skelgraph bag info|import|export|recover: MCAP recordings without DDS.
+// skelgraph bag record|play|info|merge|recover and skelgraph view (import, import-bvh,
+// export: cmd_bag_convert.cpp).
 
-#include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
-#include <iomanip>
-#include <map>
 #include <memory>
-#include <optional>
-#include <set>
-#include <tuple>
-
+#include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "cli.hpp"
+#include "cmd_bag.hpp"
 #include "run_graph.hpp"
-#include "skelgraph/runtime/registry.hpp"
-#include "skelgraph/mcap/mcap.hpp"
-#include "skelgraph/msg/cdr.hpp"
-#include "skelgraph/msg/json.hpp"
-#include "skelgraph/msg/schema.hpp"
-#include "skelgraph/calib/calib_file.hpp"
-#include "skelgraph/playback/bvh.hpp"
-#include "skelgraph/playback/readers.hpp"
-#include "skelgraph/recording/bag.hpp"
 #include "skelgraph/recording/info.hpp"
 #include "skelgraph/recording/merge.hpp"
-#include "skelgraph/recording/session_recorder.hpp"
-#include "skelgraph/recording/tick_frames.hpp"
-#include "skelgraph/runtime/topics.hpp"
-#include "skelgraph/scene/scene_export.hpp"
-#include "skelgraph/skeleton/skeleton_msg.hpp"
 
 namespace skelgraph::cli {
 
 namespace {
-
-// A bad file is the user's input: exit 2 with what and where.
-template <class F>
-auto user_input(F&& f) {
-  try {
-    return f();
-  } catch (const mcap::McapError& e) {
-    throw UsageError(e.what());
-  } catch (const playback::DataError& e) {
-    throw UsageError(e.what());
-  }
-}
-
+using bag_cmd::user_input;
 
 void print_info(const nlohmann::json& d) {
   const auto u = [](const nlohmann::json& v) { return static_cast<unsigned long long>(v.get<std::uint64_t>()); };
@@ -89,184 +58,6 @@ int info(const std::vector<std::string>& files, bool json) {
   }
   if (json) std::printf("%s\n", (files.size() == 1 ? all[0] : all).dump(2).c_str());
   return valid ? 0 : 1;
-}
-
-int import(playback::Format format, const std::vector<std::string>& files, const playback::ReadOptions& opt,
-           const std::string& out, mcap::Compression compression, bool json) {
-  mcap::WriterOptions wo;
-  wo.compression = compression;
-  recording::BagWriter bag(out, wo);
-  std::uint64_t frames = 0;
-  for (const auto& f : files) {
-    const auto rec = user_input([&] { return playback::read_recording(format, f, opt); });
-    mcap::KeyValues meta = rec.metadata;
-    meta["format"] = rec.format;
-    meta["source"] = f;
-    bag.write_metadata("import", meta);
-    for (const auto& s : rec.frames) {
-      if (s.stamp_ns < 0) throw UsageError(f + ": negative time stamp " + std::to_string(s.stamp_ns) + " cannot be recorded");
-      const auto t = static_cast<std::uint64_t>(s.stamp_ns);
-      bag.write(runtime::topics::kSkeletonRaw.name, skeleton::to_msg(s), t, t);
-      ++frames;
-    }
-    if (!json) std::fprintf(stderr, "%s: %zu frames\n", f.c_str(), rec.frames.size());
-  }
-  bag.close();
-  if (json) std::printf("%s\n", nlohmann::json{{"out", out}, {"frames", frames}, {"files", files}}.dump(2).c_str());
-  else std::printf("%s: %llu skeletons from %zu file(s)\n", out.c_str(), static_cast<unsigned long long>(frames), files.size());
-  return 0;
-}
-
-struct MocapOptions {
-  std::string file, out, add_to, transform, mapping, units = "cm", frame_id = "world", mocap_id = "mocap", time_points;
-  std::optional<double> time_offset;
-  bool json = false;
-};
-
-// Motion capture (BVH) as ground truth on skelgraph/skeleton/truth, alone or
-// added to a copy of a recording (so `eval recording` scores it against the mocap).
-int import_bvh(const MocapOptions& o) {
-  playback::BvhOptions b;
-  b.units_to_m = o.units == "mm" ? 0.001 : o.units == "m" ? 1.0 : o.units == "in" ? 0.0254 : 0.01;
-  if (!o.transform.empty()) {
-    try {
-      b.target_from_mocap = calib::read_transform_file(o.transform, o.mocap_id);
-    } catch (const calib::CalibFileError& e) {
-      throw UsageError(e.what());
-    }
-  }
-  if (!o.time_points.empty()) b.time_points = user_input([&] { return playback::read_bvh_time_points(o.time_points); });
-  if (!o.mapping.empty()) b.joints = user_input([&] { return playback::read_bvh_mapping(o.mapping); });
-  b.frame_id = o.frame_id;
-  mcap::WriterOptions wo;
-  wo.compression = mcap::Compression::Zstd;
-  recording::BagWriter bag(o.out, wo);
-  std::uint64_t copied = 0;
-  std::optional<std::uint64_t> first;
-  if (!o.add_to.empty()) {
-    const mcap::Reader reader = user_input([&] { return mcap::Reader(o.add_to); });
-    copied = user_input([&] {
-      return mcap::copy_messages(
-          reader, bag.mcap(),
-          [](const mcap::Channel& ch) { return ch.topic != runtime::topics::kSkeletonTruth.name; },  // replaced by the mocap
-          [&](const mcap::Channel&, const mcap::Schema*, const mcap::Message& m) {
-            if (!first || m.log_time < *first) first = m.log_time;
-          });
-    });
-  }
-  b.time_offset_s = o.time_offset ? *o.time_offset : first ? 1e-9 * static_cast<double>(*first) : 0.0;
-  const auto rec = user_input([&] { return playback::bvh_recording(o.file, playback::read_bvh(o.file), b); });
-  for (const auto& s : rec.frames) {
-    if (s.stamp_ns < 0) throw UsageError(o.file + ": negative time stamp; give --time-offset");
-    const auto t = static_cast<std::uint64_t>(s.stamp_ns);
-    bag.write(runtime::topics::kSkeletonTruth.name, skeleton::to_msg(s), t, t);
-  }
-  bag.write_metadata("mocap", {{"source", o.file}, {"units", o.units}, {"frame_id", o.frame_id}, {"joints", rec.metadata.at("joints")}});
-  bag.close();
-  const double span = rec.frames.size() > 1 ? 1e-9 * static_cast<double>(rec.frames.back().stamp_ns - rec.frames.front().stamp_ns) : 0.0;
-  if (o.json)
-    std::printf("%s\n", nlohmann::json{{"out", o.out}, {"truth_frames", rec.frames.size()}, {"span_s", span}, {"copied", copied},
-                                       {"time_offset_s", b.time_offset_s}}
-                            .dump(2)
-                            .c_str());
-  else
-    std::printf("%s: %zu mocap frames (%.1f s) on %s%s\n", o.out.c_str(), rec.frames.size(), span,
-                runtime::topics::kSkeletonTruth.name,
-                o.add_to.empty() ? "" : (", with the " + std::to_string(copied) + " messages of " + o.add_to).c_str());
-  return 0;
-}
-
-// The recording with the cell as a 3-D scene for Foxglove/Lichtblick added (scene_export.hpp).
-int export_scene(const std::string& file, const std::string& out, const std::string& compression, bool json) {
-  mcap::WriterOptions w;
-  w.compression = *mcap::compression_from_name(compression);
-  Progress progress(!json);
-  const auto r = user_input([&] {
-    return scene::export_scene(file, out, {}, w, [&](std::uint64_t done, std::uint64_t total) {
-      progress("copied " + std::to_string(done) + "/" + std::to_string(total) + " messages", done >= total);
-    });
-  });
-  progress.done();
-  if (json) {
-    std::printf("%s\n", nlohmann::json{{"out", out},
-                                       {"copied", r.copied},
-                                       {"skeletons", r.skeletons},
-                                       {"poses", r.poses},
-                                       {"pointing", r.pointing},
-                                       {"robot_states", r.robot_states},
-                                       {"safety", r.safety},
-                                       {"scene_updates", r.updates},
-                                       {"entities", r.entities},
-                                       {"transforms", r.transforms},
-                                       {"undecodable", r.undecodable},
-                                       {"unplaced_frames", r.unplaced}}
-                            .dump(2)
-                            .c_str());
-  } else {
-    std::printf("%s: the %llu messages of %s, and the scene: %llu updates (%llu entities from %llu skeletons, %llu pointing "
-                "events, %llu robot states) on %s, %llu transforms on %s\n",
-                out.c_str(), static_cast<unsigned long long>(r.copied), file.c_str(), static_cast<unsigned long long>(r.updates),
-                static_cast<unsigned long long>(r.entities), static_cast<unsigned long long>(r.skeletons),
-                static_cast<unsigned long long>(r.pointing), static_cast<unsigned long long>(r.robot_states), scene::kSceneTopic,
-                static_cast<unsigned long long>(r.transforms), scene::kTransformTopic);
-  }
-  for (const auto& f : r.unplaced)
-    std::fprintf(stderr, "note: frame '%s' has no pose in the recording: drawn at the world's origin\n", f.c_str());
-  if (r.undecodable > 0) std::fprintf(stderr, "warning: %llu messages did not decode and are not in the scene\n",
-                                      static_cast<unsigned long long>(r.undecodable));
-  return 0;
-}
-
-// generic: our lossless CSV (reads back with the generic reader). csv: plain
-// numeric columns per sensor, one line per frame, as the thesis's per-Kinect
-// text logs were: time, person, then x, y, z, confidence of every joint.
-int export_bag(const std::string& file, const std::string& format, const std::string& dir, bool json) {
-  const mcap::Reader reader = user_input([&] { return mcap::Reader(file); });
-  std::map<std::string, playback::Recording> by_stream;  // "<topic tail>_<sensor>"
-  user_input([&] {
-    reader.for_each_message([&](const mcap::Channel& ch, const mcap::Schema* schema, const mcap::Message& m) {
-      if (schema == nullptr || schema->name != msg::MessageTraits<msg::Skeleton>::name) return;
-      auto s = skeleton::from_msg(msg::from_cdr<msg::Skeleton>(m.data.data(), m.data.size()));
-      const auto tail = ch.topic.substr(ch.topic.rfind('/') + 1);
-      auto& rec = by_stream[recording::file_safe(tail + "_" + s.sensor_id)];
-      rec.format = "generic";
-      rec.metadata["topic"] = ch.topic;
-      rec.metadata["source"] = file;
-      rec.frames.push_back(std::move(s));
-    });
-    return 0;
-  });
-  std::filesystem::create_directories(dir);
-  nlohmann::json written = nlohmann::json::object();
-  for (auto& [name, rec] : by_stream) {
-    const auto path = std::filesystem::path(dir) / (name + ".csv");
-    std::ofstream out(path);
-    if (!out) throw std::runtime_error("cannot write " + path.string());
-    if (format == "generic") {
-      playback::write_generic_csv(rec, out);
-    } else {
-      out << "stamp_ns,time_s,person_id,frame_number";
-      for (std::size_t j = 0; j < skeleton::kJointCount; ++j) {
-        const std::string n = skeleton::joint_name(skeleton::joint_at(j));
-        out << "," << n << "_x," << n << "_y," << n << "_z," << n << "_conf";
-      }
-      out << "\n" << std::setprecision(9);
-      const auto t0 = rec.frames.empty() ? 0 : rec.frames.front().stamp_ns;
-      for (const auto& s : rec.frames) {
-        out << s.stamp_ns << "," << static_cast<double>(s.stamp_ns - t0) * 1e-9 << "," << s.person_id << ","
-            << s.frame_number;
-        for (const auto& j : s.joints) {
-          out << "," << j.position.x() << "," << j.position.y() << "," << j.position.z() << "," << j.confidence;
-        }
-        out << "\n";
-      }
-    }
-    if (!out.flush()) throw std::runtime_error("error writing " + path.string());
-    written[path.string()] = rec.frames.size();
-  }
-  if (json) std::printf("%s\n", nlohmann::json{{"files", written}}.dump(2).c_str());
-  else for (const auto& [p, n] : written.items()) std::printf("%s: %s frames\n", p.c_str(), n.dump().c_str());
-  return 0;
 }
 
 int recover(const std::string& in, const std::string& out, bool json) {
@@ -440,66 +231,7 @@ void add_bag_command(CLI::App& app, GlobalOptions& g, Action& run) {
   i->add_flag("--json", o->json, "machine-readable output (several files: an array)");
   i->callback([o, &run] { run = [o] { return info(o->files, o->json); }; });
 
-  auto* im = bag->add_subcommand("import", "Data-set files (the playback formats) into an MCAP recording on skelgraph/skeleton/raw");
-  im->add_option("format", o->format, "file format")->required()->check(CLI::IsMember(playback::format_names()));
-  im->add_option("files", o->files, "files to import")->required()->check(CLI::ExistingFile);
-  im->add_option("--out", o->out, "MCAP file to write")->required();
-  im->add_option("--compression", o->compression, "chunk compression")->check(CLI::IsMember({"none", "lz4", "zstd"}));
-  im->add_option("--on-error", o->on_error, "a bad line: stop (default) or skip it")->check(CLI::IsMember({"stop", "skip"}));
-  im->add_option("--sensor-id", o->sensor_id, "sensor id to record under (multitrack: a prefix)");
-  im->add_flag("--json", o->json, "machine-readable summary");
-  im->callback([o, &run] {
-    run = [o] {
-      playback::ReadOptions opt;
-      opt.on_error = o->on_error == "skip" ? playback::ReadOptions::OnError::Skip : playback::ReadOptions::OnError::Stop;
-      opt.sensor_id = o->sensor_id;
-      return import(*playback::format_from_name(o->format), o->files, opt, o->out,
-                    *mcap::compression_from_name(o->compression), o->json);
-    };
-  });
-
-  auto mo = std::make_shared<MocapOptions>();
-  auto* ib = bag->add_subcommand("import-bvh", "Motion capture (BVH) as ground truth on skelgraph/skeleton/truth, alone or added "
-                                              "to a copy of a recording, so `eval recording` scores the recording against it");
-  ib->add_option("file", mo->file, "BVH file")->required()->check(CLI::ExistingFile);
-  ib->add_option("--out", mo->out, "MCAP file to write")->required();
-  ib->add_option("--add-to", mo->add_to, "a recording copied into --out first (its own truth left out)")->check(CLI::ExistingFile);
-  ib->add_option("--units", mo->units, "the BVH's length unit: cm (default), mm, m, in")->check(CLI::IsMember({"cm", "mm", "m", "in"}));
-  ib->add_option("--transform", mo->transform,
-                 "the mocap frame into the target frame: YAML with rotation: [9, row-major] and translation: [x, y, z] metres, "
-                 "or a calibration file with the motion-capture system as a sensor (--mocap-id)")
-      ->check(CLI::ExistingFile);
-  ib->add_option("--frame-id", mo->frame_id, "the frame the positions end up in (default world; a sensor's id for its frame)");
-  ib->add_option("--time-offset", mo->time_offset,
-                 "frame 0's time, seconds on the recording's clock (default: the --add-to recording's first message, else 0)");
-  ib->add_option("--mocap-id", mo->mocap_id, "with a calibration file as --transform: the motion-capture system's entry (default mocap)");
-  ib->add_option("--time-points", mo->time_points,
-                 "CSV mocap_frame,time_s: matched moments (recording clock, s); frame times follow the line through them "
-                 "(instead of --time-offset and the file's frame time)")
-      ->check(CLI::ExistingFile)
-      ->excludes("--time-offset");
-  ib->add_option("--mapping", mo->mapping, "YAML joints: {head: NAME, ...} for names the default mapping does not know")
-      ->check(CLI::ExistingFile);
-  ib->add_flag("--json", mo->json, "machine-readable summary");
-  ib->callback([mo, &run] { run = [mo] { return import_bvh(*mo); }; });
-
-  auto* ex = bag->add_subcommand("export", "Skeletons of a recording to CSV files, one per topic and sensor; or with --scene the "
-                                          "recording with the cell as a 3-D scene for Foxglove/Lichtblick added");
-  ex->add_option("file", o->file, "MCAP file")->required()->check(CLI::ExistingFile);
-  auto* fmt = ex->add_option("--format", o->format, "csv: numeric columns (x, y, z, confidence per joint); generic: skelgraph's lossless CSV")
-      ->check(CLI::IsMember({"csv", "generic"}));
-  auto* scene_flag = ex->add_flag("--scene", o->scene,
-               "--out is an MCAP file: every message of FILE plus foxglove::SceneUpdate on skelgraph/scene/update (skeletons, "
-               "sensors, pointing, the robot) and foxglove::FrameTransform on skelgraph/scene/transforms");
-  scene_flag->excludes(fmt);
-  ex->add_option("--compression", o->compression, "--scene: chunk compression (default zstd)")
-      ->check(CLI::IsMember({"none", "lz4", "zstd"}))
-      ->needs(scene_flag);
-  ex->add_option("--out", o->out, "output directory (--scene: the MCAP file)")->required();
-  ex->add_flag("--json", o->json, "machine-readable summary");
-  ex->callback([o, &run] {
-    run = [o] { return o->scene ? export_scene(o->file, o->out, o->compression, o->json) : export_bag(o->file, o->format, o->out, o->json); };
-  });
+  bag_cmd::add_convert_commands(*bag, run);
 
   auto* mg = bag->add_subcommand("merge", "Several hosts' recordings of a session onto the sync master's timeline");
   mg->add_option("files", o->files, "recordings (one per host)")->required()->check(CLI::ExistingFile);
