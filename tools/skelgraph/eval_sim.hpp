@@ -6,6 +6,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "skelgraph/eval/offline.hpp"
+
 namespace skelgraph::cli {
 
 struct SimEvalOptions {
@@ -30,6 +32,9 @@ struct SimEvalOptions {
 
 // Prints the tables (Markdown, or JSON with `json`), writes the report when report_dir is set.
 int eval_sim(const SimEvalOptions& o);
+
+// One run's table of every stream (Markdown), under `### title`.
+void print_table(const std::string& title, const eval::OfflineResult& r);
 
 // A recording scored as `skelgraph eval recording` does (single sensors, every
 // method re-run offline, and the live fusion streams it recorded), for a report:

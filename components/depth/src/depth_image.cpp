@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <tuple>
 
 namespace skelgraph::depth {
 
@@ -26,6 +27,13 @@ calib::Intrinsics kinect_intrinsics(int width, int height) {
   k.cx = (width - 1) / 2.0;
   k.cy = (height - 1) / 2.0;
   return k;
+}
+
+calib::Intrinsics parse_depth_size(const std::string& size) {
+  for (const auto& [name, w, h] : {std::tuple{"160x120", 160, 120}, {"320x240", 320, 240}, {"640x480", 640, 480}}) {
+    if (size == name) return kinect_intrinsics(w, h);
+  }
+  throw std::invalid_argument("depth_size '" + size + "': expected 160x120, 320x240 or 640x480");
 }
 
 calib::Intrinsics intrinsics_from_fov(int width, int height, double hfov_rad, double vfov_rad) {

@@ -1,4 +1,5 @@
 #include "skelgraph/eval/report.hpp"
+#include "skelgraph/skeleton/json_number.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -214,6 +215,37 @@ std::string write_report_page(const std::string& dir, const std::string& heading
     << sections << "</body></html>\n";
   if (!f.flush()) throw std::runtime_error("cannot write " + path.string());
   return path.string();
+}
+
+nlohmann::json stream_json(const StreamScore& s) {
+  nlohmann::json groups = nlohmann::json::object();
+  const auto f = s.accuracy.figures();
+  for (std::size_t g = 0; g < kGroupCount; ++g) {
+    groups[group_names()[g]] = {{"detection_pct", f[g].detection_pct}, {"error_cm", json_number(f[g].error_cm)}};
+  }
+  return {{"stream", s.name},
+          {"fused", s.fused},
+          {"groups", groups},
+          {"mean_error_cm", json_number(s.accuracy.mean_error_cm())},
+          {"mean_group_error_cm", json_number(s.accuracy.mean_group_error_cm())},
+          {"at_use_mean_error_cm", json_number(s.at_use.mean_error_cm())},
+          {"at_use_mean_group_error_cm", json_number(s.at_use.mean_group_error_cm())},
+          {"after_calibration_mean_error_cm", json_number(s.after_calibration.mean_error_cm())},
+          {"compensated_mean_error_cm", json_number(s.compensated.mean_error_cm())},
+          {"upper_body_complete_pct", s.steadiness.upper_body_complete_pct()},
+          {"upper_body_complete_when_a_single_sensor_is_pct", s.complete_when_single_pct()},
+          {"bone_length_sd_cm", json_number(s.steadiness.mean_bone_sd_cm())},
+          {"uncertainty",
+           {{"joint_ticks", s.uncertainty.joint_ticks()},
+            {"inside_95_pct", json_number(s.uncertainty.inside_95_pct())},
+            {"sigma_error_spearman", json_number(s.uncertainty.sigma_error_spearman())},
+            {"median_sigma_cm", json_number(s.uncertainty.median_sigma_cm())},
+            {"reliability", s.uncertainty.reliability()}}},
+          {"ticks", s.ticks},
+          {"ticks_with_output", s.with_output},
+          {"id_switches", s.id_switches},
+          {"id_switches_after_gap", s.id_switches_after_gap},
+          {"id_switches_per_person_minute", json_number(s.id_switches_per_person_minute())}};
 }
 
 }  // namespace skelgraph::eval

@@ -34,13 +34,6 @@ void add_sim_params(runtime::ParamSchema& schema) {
                   "moved to its own left); the poses published stay the calibrated ones (default: none)");
 }
 
-calib::Intrinsics parse_depth_size(const std::string& size) {
-  for (const auto& [name, w, h] : {std::tuple{"160x120", 160, 120}, {"320x240", 320, 240}, {"640x480", 640, 480}}) {
-    if (size == name) return depth::kinect_intrinsics(w, h);
-  }
-  throw std::invalid_argument("depth_size '" + size + "': expected 160x120, 320x240 or 640x480");
-}
-
 SimConfig sim_config_from(const runtime::Params& params) {
   SimConfig c;
   c.scenario.name = params.get<std::string>("scenario");
@@ -113,7 +106,7 @@ SimComponent::SimComponent(runtime::Context& ctx, const runtime::Params& params)
   publish_truth_ = params.get<bool>("publish_truth");
   publish_raw_ = params.get<bool>("publish_raw");
   if (params.get<bool>("depth")) {
-    const auto k = parse_depth_size(params.get<std::string>("depth_size"));
+    const auto k = depth::parse_depth_size(params.get<std::string>("depth_size"));
     DepthNoise noise;
     noise.enabled = params.get<bool>("depth_noise");
     girth_ = params.get<double>("depth_girth");

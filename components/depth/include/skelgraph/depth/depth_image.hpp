@@ -37,6 +37,8 @@ struct DepthImage {
 // 580 at 640 x 480 (the IR camera's; a 57.8 x 45 degree field of view), scaled
 // for other sizes of the same aspect.
 calib::Intrinsics kinect_intrinsics(int width = 640, int height = 480);
+// "WxH" (160x120, 320x240 or 640x480) -> kinect_intrinsics of that size; throws std::invalid_argument naming the accepted sizes.
+calib::Intrinsics parse_depth_size(const std::string& size);
 // Intrinsics from fields of view (OpenNI2 reports only these), pixel centre at the middle.
 calib::Intrinsics intrinsics_from_fov(int width, int height, double hfov_rad, double vfov_rad);
 

@@ -74,9 +74,6 @@ struct RecordingOptions {
 OfflineOptions offline_options(const std::vector<std::string>& methods, double delay_ms, double max_age_ms);
 OfflineOptions offline_options(const RecordingOptions& o, const RecordingInputs& in);
 
-// A stream's figures as JSON (the `--json` of every eval command).
-nlohmann::json stream_json(const StreamScore& s);
-
 // Single sensors and every method, against the truth in the recording if it
 // has one; bone-length steadiness and completeness either way. `summary` is
 // the `eval recording --json` object.

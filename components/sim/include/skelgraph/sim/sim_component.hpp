@@ -65,7 +65,5 @@ class SimComponent final : public runtime::Component {
 SimConfig sim_config_from(const runtime::Params& params);
 // The parameters both take.
 void add_sim_params(runtime::ParamSchema& schema);
-// "WxH" -> Kinect-like intrinsics of that size; throws std::invalid_argument naming the accepted sizes.
-calib::Intrinsics parse_depth_size(const std::string& size);
 
 }  // namespace skelgraph::sim
