@@ -10,7 +10,7 @@
 #include <limits>
 #include <random>
 
-#include "skelgraph/gesture/hmm.hpp"
+#include "skelgraph/gesture/gaussian_mixture.hpp"
 
 using namespace skelgraph::gesture;
 
@@ -59,12 +59,12 @@ int main(int argc, char** argv) {
   // k-means and the E-step that scores it): their difference over the
   // iterations is Baum-Welch alone, as pomegranate's figure is.
   TrainReport rep;
-  Hmm h;
+  GaussianHmm h;
   const auto best_of = [&](const TrainOptions& opt) {
     double best = 1e300;
     for (int run = 0; run < 10; ++run) {
       const auto t0 = clock::now();
-      h = Hmm::train(data, opt, &rep);
+      h = GaussianHmm::train(data, opt, &rep);
       best = std::min(best, std::chrono::duration<double>(clock::now() - t0).count());
     }
     return best;

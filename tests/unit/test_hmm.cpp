@@ -18,7 +18,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
-#include "skelgraph/gesture/hmm.hpp"
+#include "skelgraph/gesture/gaussian_mixture.hpp"
 
 using namespace skelgraph::gesture;
 using Eigen::MatrixXd;
@@ -36,8 +36,8 @@ GaussianMixture gauss(std::vector<double> mean, double sd) {
 }
 
 // Three states in 2-D, a loop 0 -> 1 -> 2 -> 0.
-Hmm three_states() {
-  Hmm h(3, 2, Covariance::Full);
+GaussianHmm three_states() {
+  GaussianHmm h;
   VectorXd start(3);
   start << 0.6, 0.3, 0.1;
   MatrixXd a(3, 3);
@@ -46,11 +46,11 @@ Hmm three_states() {
   g2.weights = VectorXd::Constant(2, 0.5);
   g2.means.push_back((VectorXd(2) << 0.5, 4).finished());
   g2.covs.push_back((MatrixXd(2, 2) << 0.4, 0.1, 0.1, 0.3).finished());
-  h.set(start, a, {gauss({0, 0}, 0.5), gauss({3, 0}, 0.5), g2});
+  h.set(start, a, GaussianMixtureEmission(2, Covariance::Full, {gauss({0, 0}, 0.5), gauss({3, 0}, 0.5), g2}));
   return h;
 }
 
-Sequence sample(const Hmm& h, int T, std::mt19937_64& rng, std::vector<int>* states = nullptr) {
+Sequence sample(const GaussianHmm& h, int T, std::mt19937_64& rng, std::vector<int>* states = nullptr) {
   const VectorXd start = h.start();
   const MatrixXd a = h.transitions();
   const auto draw = [&](const VectorXd& p) {
@@ -66,7 +66,7 @@ Sequence sample(const Hmm& h, int T, std::mt19937_64& rng, std::vector<int>* sta
   for (int t = 0; t < T; ++t) {
     if (t > 0) s = draw(a.row(s).transpose());
     if (states) states->push_back(s);
-    const auto& g = h.emissions()[static_cast<std::size_t>(s)];
+    const auto& g = h.emission().mixtures()[static_cast<std::size_t>(s)];
     const int m = draw(g.weights);
     const Eigen::LLT<MatrixXd> llt(g.covs[static_cast<std::size_t>(m)]);
     VectorXd z(h.dim());
@@ -79,7 +79,7 @@ Sequence sample(const Hmm& h, int T, std::mt19937_64& rng, std::vector<int>* sta
 }  // namespace
 
 TEST(Hmm, ForwardAndViterbiMatchBruteForce) {
-  const Hmm h = three_states();
+  const GaussianHmm h = three_states();
   std::mt19937_64 rng(1);
   const Sequence x = sample(h, 6, rng);
   const VectorXd start = h.start();
@@ -94,7 +94,7 @@ TEST(Hmm, ForwardAndViterbiMatchBruteForce) {
     }
     for (int s = 0; s < 3; ++s) {
       path[static_cast<std::size_t>(t)] = s;
-      const double e = std::exp(h.emissions()[static_cast<std::size_t>(s)].log_pdf(x.row(t).transpose()));
+      const double e = std::exp(h.emission().mixtures()[static_cast<std::size_t>(s)].log_pdf(x.row(t).transpose()));
       walk(t + 1, p * (t == 0 ? start(s) : a(path[static_cast<std::size_t>(t - 1)], s)) * e);
     }
   };
@@ -153,8 +153,8 @@ TEST(Hmm, PosteriorsMatchBruteForce) {
       }
       em.push_back(g);
     }
-    Hmm h(n, 1, Covariance::Full);
-    h.set(c.start, c.a, em);
+    GaussianHmm h;
+    h.set(c.start, c.a, GaussianMixtureEmission(1, Covariance::Full, em));
     const auto emit = [&](int s, double x) {
       double p = 0;
       for (const auto& comp : c.mix[static_cast<std::size_t>(s)]) p += comp[0] * normal(x, comp[1], comp[2]);
@@ -188,7 +188,7 @@ TEST(Hmm, PosteriorsMatchBruteForce) {
     EXPECT_NEAR(h.log_likelihood(x), std::log(total), 1e-9) << "case " << k;
     // The control: the posteriors are neither the filtered (forward-only)
     // ones nor all near 0 or 1, so a wrong backward pass would show.
-    const Hmm::Pass fwd = h.pass(x, false);
+    const GaussianHmm::Pass fwd = h.pass(x, false);
     double differ = 0, spread = 0;
     for (int t = 0; t < T; ++t) {
       for (int i = 0; i < n; ++i) {
@@ -231,12 +231,12 @@ TEST(Hmm, RegularisationKeepsDegenerateCovariancesPositiveDefinite) {
         o.covariance = cov;
         o.init = init;
         o.max_iterations = 30;
-        Hmm h;
+        GaussianHmm h;
         TrainReport rep;
-        ASSERT_NO_THROW(h = Hmm::train(data, o, &rep)) << what;
+        ASSERT_NO_THROW(h = GaussianHmm::train(data, o, &rep)) << what;
         ASSERT_FALSE(rep.log_likelihood.empty()) << what;
         for (const double ll : rep.log_likelihood) EXPECT_TRUE(std::isfinite(ll)) << what;
-        for (const auto& g : h.emissions()) {
+        for (const auto& g : h.emission().mixtures()) {
           for (const auto& s : g.covs) {
             ASSERT_EQ(s.rows(), 4);
             EXPECT_TRUE(s.allFinite()) << what;
@@ -258,7 +258,7 @@ TEST(Hmm, RegularisationKeepsDegenerateCovariancesPositiveDefinite) {
         EXPECT_GT(h.log_likelihood(nudged), h.log_likelihood(fresh) - 10.0 * static_cast<double>(fresh.rows())) << what;
         // The control: without regularisation the constant feature's variance is 0.
         o.regularisation = 0;
-        EXPECT_THROW(Hmm::train(data, o), ModelError) << what;
+        EXPECT_THROW(GaussianHmm::train(data, o), ModelError) << what;
       }
     }
   }
@@ -296,28 +296,28 @@ TEST(Hmm, AConstantFeatureShiftsNoModelAgainstAnotherWithASharedSpread) {
   TrainOptions o;
   o.states = 2;
   o.covariance = Covariance::Diagonal;
-  const double gap = Hmm::train(a, o).log_likelihood(test) - Hmm::train(b, o).log_likelihood(test);
+  const double gap = GaussianHmm::train(a, o).log_likelihood(test) - GaussianHmm::train(b, o).log_likelihood(test);
   TrainOptions shared = o;
   shared.constant_spread = Eigen::Vector3d(0.2, 0.2, 0.2);
-  const double gap3 = Hmm::train(with_constant(a), shared).log_likelihood(test3) -
-                      Hmm::train(with_constant(b), shared).log_likelihood(test3);
+  const double gap3 = GaussianHmm::train(with_constant(a), shared).log_likelihood(test3) -
+                      GaussianHmm::train(with_constant(b), shared).log_likelihood(test3);
   EXPECT_NEAR(gap3, gap, 1e-6 * std::abs(gap));
   // The control: each model's own mean spread for the constant feature.
-  const double own = Hmm::train(with_constant(a), o).log_likelihood(test3) - Hmm::train(with_constant(b), o).log_likelihood(test3);
+  const double own = GaussianHmm::train(with_constant(a), o).log_likelihood(test3) - GaussianHmm::train(with_constant(b), o).log_likelihood(test3);
   EXPECT_GT(std::abs(own - gap), 1.0);
   TrainOptions wrong = o;
   wrong.constant_spread = Eigen::Vector2d(0.2, 0.2);
-  EXPECT_THROW(Hmm::train(with_constant(a), wrong), ModelError);
+  EXPECT_THROW(GaussianHmm::train(with_constant(a), wrong), ModelError);
 }
 
 TEST(Hmm, LongSequencesDoNotUnderflowAndStreamingMatches) {
-  const Hmm h = three_states();
+  const GaussianHmm h = three_states();
   std::mt19937_64 rng(2);
   const Sequence x = sample(h, 20000, rng);
   const double ll = h.log_likelihood(x);
   EXPECT_TRUE(std::isfinite(ll));
   EXPECT_LT(ll, -20000);  // far below what a plain product of probabilities could hold
-  Hmm::Stream s(h);
+  GaussianHmm::Stream s(h);
   double streamed = 0;
   for (Eigen::Index t = 0; t < x.rows(); ++t) streamed = s.step(x.row(t).transpose());
   EXPECT_NEAR(streamed, ll, 1e-6 * std::abs(ll));
@@ -325,7 +325,7 @@ TEST(Hmm, LongSequencesDoNotUnderflowAndStreamingMatches) {
 }
 
 TEST(Hmm, BaumWelchFindsTheGeneratingStates) {
-  const Hmm truth = three_states();
+  const GaussianHmm truth = three_states();
   std::mt19937_64 rng(3);
   std::vector<Sequence> data;
   for (int i = 0; i < 60; ++i) data.push_back(sample(truth, 40 + 5 * (i % 7), rng));  // different lengths
@@ -333,7 +333,7 @@ TEST(Hmm, BaumWelchFindsTheGeneratingStates) {
   o.states = 3;
   o.mixtures = 2;
   TrainReport rep;
-  const Hmm h = Hmm::train(data, o, &rep);
+  const GaussianHmm h = GaussianHmm::train(data, o, &rep);
   ASSERT_GE(rep.log_likelihood.size(), 3u);
   for (std::size_t i = 1; i < rep.log_likelihood.size(); ++i) {
     EXPECT_GE(rep.log_likelihood[i], rep.log_likelihood[i - 1] - 1e-6 * std::abs(rep.log_likelihood[i - 1])) << i;
@@ -351,34 +351,35 @@ TEST(Hmm, BaumWelchFindsTheGeneratingStates) {
   // Each true state's mean is near one learnt component.
   for (const auto& want : {VectorXd((VectorXd(2) << 0, 0).finished()), VectorXd((VectorXd(2) << 3, 0).finished())}) {
     double best = 1e9;
-    for (const auto& g : h.emissions()) {
+    for (const auto& g : h.emission().mixtures()) {
       for (const auto& m : g.means) best = std::min(best, (m - want).norm());
     }
     EXPECT_LT(best, 0.2);
   }
   // Deterministic with the seed.
-  const Hmm again = Hmm::train(data, o);
+  const GaussianHmm again = GaussianHmm::train(data, o);
   EXPECT_DOUBLE_EQ(again.log_likelihood(data[0]), h.log_likelihood(data[0]));
   // A left-right chain over k-means clusters (which come in no order) is refused.
   TrainOptions lrk = o;
   lrk.left_right = true;
   lrk.init = Init::KMeans;
-  EXPECT_THROW(Hmm::train(data, lrk), ModelError);
+  EXPECT_THROW(GaussianHmm::train(data, lrk), ModelError);
   // Diagonal covariances and a left-right topology train too.
   o.covariance = Covariance::Diagonal;
   o.left_right = true;
-  const Hmm lr = Hmm::train(data, o);
+  const GaussianHmm lr = GaussianHmm::train(data, o);
   EXPECT_EQ(lr.transitions()(2, 0), 0.0);
-  EXPECT_EQ(lr.emissions()[0].covs[0](0, 1), 0.0);
+  EXPECT_EQ(lr.emission().mixtures()[0].covs[0](0, 1), 0.0);
 }
 
 // States visited in no particular order: k-means initialisation puts a state
 // on each cluster of frames, with uniform start and transitions, before any
 // Baum-Welch iteration; cutting the sequences into equal parts would mix them.
 TEST(Hmm, KMeansInitialisationStartsAStateOnEachCluster) {
-  Hmm truth = three_states();
+  GaussianHmm truth = three_states();
   MatrixXd uniform = MatrixXd::Constant(3, 3, 1.0 / 3);
-  truth.set(VectorXd::Constant(3, 1.0 / 3), uniform, {gauss({0, 0}, 0.3), gauss({4, 0}, 0.3), gauss({0, 4}, 0.3)});
+  truth.set(VectorXd::Constant(3, 1.0 / 3), uniform,
+            GaussianMixtureEmission(2, Covariance::Full, {gauss({0, 0}, 0.3), gauss({4, 0}, 0.3), gauss({0, 4}, 0.3)}));
   std::mt19937_64 rng(5);
   std::vector<Sequence> data;
   for (int i = 0; i < 30; ++i) data.push_back(sample(truth, 50, rng));
@@ -386,20 +387,20 @@ TEST(Hmm, KMeansInitialisationStartsAStateOnEachCluster) {
   o.states = 3;
   o.covariance = Covariance::Diagonal;
   o.max_iterations = 0;  // the initial model itself
-  const auto nearest = [](const Hmm& h, const VectorXd& want) {
+  const auto nearest = [](const GaussianHmm& h, const VectorXd& want) {
     double best = 1e9;
-    for (const auto& g : h.emissions()) best = std::min(best, (g.means[0] - want).norm());
+    for (const auto& g : h.emission().mixtures()) best = std::min(best, (g.means[0] - want).norm());
     return best;
   };
   const std::vector<VectorXd> centres = {(VectorXd(2) << 0, 0).finished(), (VectorXd(2) << 4, 0).finished(),
                                          (VectorXd(2) << 0, 4).finished()};
   o.init = Init::KMeans;
-  const Hmm k = Hmm::train(data, o);
+  const GaussianHmm k = GaussianHmm::train(data, o);
   for (const auto& c : centres) EXPECT_LT(nearest(k, c), 0.1);
   EXPECT_NEAR(k.transitions()(0, 1), 1.0 / 3, 1e-12);
   EXPECT_NEAR(k.start()(2), 1.0 / 3, 1e-12);
   o.init = Init::Segments;
-  const Hmm seg = Hmm::train(data, o);
+  const GaussianHmm seg = GaussianHmm::train(data, o);
   double worst = 0;
   for (const auto& c : centres) worst = std::max(worst, nearest(seg, c));
   EXPECT_GT(worst, 1.0);  // the control: equal parts of shuffled states start on mixtures of them
@@ -408,7 +409,7 @@ TEST(Hmm, KMeansInitialisationStartsAStateOnEachCluster) {
 // restarts = R keeps, of R trainings from different seeds, the one with the
 // highest final training likelihood.
 TEST(Hmm, RestartsKeepTheBestFit) {
-  const Hmm truth = three_states();
+  const GaussianHmm truth = three_states();
   std::mt19937_64 rng(11);
   std::vector<Sequence> data;
   for (int i = 0; i < 20; ++i) data.push_back(sample(truth, 30 + 3 * i, rng));
@@ -418,14 +419,14 @@ TEST(Hmm, RestartsKeepTheBestFit) {
   o.seed = 8;
   o.restarts = 5;
   TrainReport best;
-  const Hmm h = Hmm::train(data, o, &best);
+  const GaussianHmm h = GaussianHmm::train(data, o, &best);
   std::vector<double> finals;
   for (int r = 0; r < 5; ++r) {
     TrainOptions one = o;
     one.restarts = 1;
     one.seed = o.seed + 0x9E3779B97F4A7C15ULL * static_cast<std::uint64_t>(r);
     TrainReport rep;
-    Hmm::train(data, one, &rep);
+    GaussianHmm::train(data, one, &rep);
     finals.push_back(rep.log_likelihood.back());
   }
   const double top = *std::max_element(finals.begin(), finals.end());
@@ -439,13 +440,13 @@ TEST(Hmm, RestartsKeepTheBestFit) {
 
 // The forward pass in log space, each emission straight from its Gaussians
 // (Cholesky factors), none of the batched quadratic-feature arithmetic.
-double log_space_forward(const Hmm& h, const Sequence& x) {
+double log_space_forward(const GaussianHmm& h, const Sequence& x) {
   const auto n = h.states();
   const MatrixXd log_a = h.transitions().array().log().matrix();
   VectorXd alpha = h.start().array().log().matrix(), next(n);
   for (Eigen::Index t = 0; t < x.rows(); ++t) {
     for (int j = 0; j < n; ++j) {
-      const double e = h.emissions()[static_cast<std::size_t>(j)].log_pdf(x.row(t).transpose());
+      const double e = h.emission().mixtures()[static_cast<std::size_t>(j)].log_pdf(x.row(t).transpose());
       next(j) = e + (t == 0 ? alpha(j) : log_sum_exp(alpha + log_a.col(j)));
     }
     alpha = next;
@@ -457,9 +458,9 @@ TEST(Hmm, FramesFarFromTheOriginKeepTheirPrecision) {
   // Narrow Gaussians 1000 units from the origin: expanding (x - mu)' P (x - mu)
   // about the origin would cancel away most of the digits.
   for (const auto cov : {Covariance::Full, Covariance::Diagonal}) {
-    Hmm h = three_states();
+    GaussianHmm h = three_states();
     VectorXd start = h.start();
-    std::vector<GaussianMixture> em = h.emissions();
+    std::vector<GaussianMixture> em = h.emission().mixtures();
     for (auto& g : em) {
       for (std::size_t m = 0; m < g.means.size(); ++m) {
         g.means[m].array() += 1000.0;
@@ -467,8 +468,8 @@ TEST(Hmm, FramesFarFromTheOriginKeepTheirPrecision) {
         if (cov == Covariance::Diagonal) g.covs[m] = MatrixXd(g.covs[m].diagonal().asDiagonal());
       }
     }
-    Hmm far(3, 2, cov);
-    far.set(start, h.transitions(), em);
+    GaussianHmm far;
+    far.set(start, h.transitions(), GaussianMixtureEmission(2, cov, em));
     std::mt19937_64 rng(7);
     for (int i = 0; i < 5; ++i) {
       const Sequence x = sample(far, 50, rng);
@@ -477,7 +478,7 @@ TEST(Hmm, FramesFarFromTheOriginKeepTheirPrecision) {
     }
   }
   // Training on data moved by 1000 finds the same model, moved.
-  const Hmm truth = three_states();
+  const GaussianHmm truth = three_states();
   std::mt19937_64 rng(8);
   std::vector<Sequence> near, moved;
   for (int i = 0; i < 30; ++i) {
@@ -488,22 +489,22 @@ TEST(Hmm, FramesFarFromTheOriginKeepTheirPrecision) {
   o.states = 3;
   o.mixtures = 2;
   o.max_iterations = 20;
-  const Hmm a = Hmm::train(near, o), b = Hmm::train(moved, o);
+  const GaussianHmm a = GaussianHmm::train(near, o), b = GaussianHmm::train(moved, o);
   for (std::size_t i = 0; i < 5; ++i) {
     EXPECT_NEAR(b.log_likelihood(moved[i]), a.log_likelihood(near[i]), 1e-6 * std::abs(a.log_likelihood(near[i])));
   }
 }
 
 TEST(Hmm, SaveLoadAndMalformedModels) {
-  const Hmm h = three_states();
+  const GaussianHmm h = three_states();
   const auto j = h.to_json();
-  const Hmm back = Hmm::from_json(nlohmann::json::parse(j.dump()));
+  const GaussianHmm back = GaussianHmm::from_json(nlohmann::json::parse(j.dump()));
   std::mt19937_64 rng(4);
   const Sequence x = sample(h, 50, rng);
   EXPECT_NEAR(back.log_likelihood(x), h.log_likelihood(x), 1e-9);
   const auto error_of = [](nlohmann::json m) {
     try {
-      Hmm::from_json(m);
+      GaussianHmm::from_json(m);
     } catch (const ModelError& e) {
       return std::string(e.what());
     }
@@ -526,8 +527,8 @@ TEST(Hmm, SaveLoadAndMalformedModels) {
   EXPECT_NE(error_of(bad).find("not a skelgraph HMM"), std::string::npos);
   // Training input problems are clear too.
   TrainOptions o;
-  EXPECT_THROW(Hmm::train({}, o), ModelError);
-  EXPECT_THROW(Hmm::train({MatrixXd::Zero(5, 2), MatrixXd::Zero(5, 3)}, o), ModelError);
+  EXPECT_THROW(GaussianHmm::train({}, o), ModelError);
+  EXPECT_THROW(GaussianHmm::train({MatrixXd::Zero(5, 2), MatrixXd::Zero(5, 3)}, o), ModelError);
   EXPECT_THROW(h.log_likelihood(MatrixXd::Zero(4, 3)), ModelError);
 }
 
@@ -541,7 +542,7 @@ TEST(HmmPeer, PomegranateAgreesOnLikelihoodAndViterbi) {
   const auto dir = std::filesystem::temp_directory_path() / ("skelgraph_hmm_peer_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   for (const auto cov : {Covariance::Full, Covariance::Diagonal}) {
-    Hmm h = three_states();
+    GaussianHmm h = three_states();
     if (cov == Covariance::Diagonal) {
       // The same model with diagonal covariances, trained so the numbers are not round.
       std::mt19937_64 rng(5);
@@ -551,7 +552,7 @@ TEST(HmmPeer, PomegranateAgreesOnLikelihoodAndViterbi) {
       o.states = 3;
       o.mixtures = 2;
       o.covariance = Covariance::Diagonal;
-      h = Hmm::train(data, o);
+      h = GaussianHmm::train(data, o);
     }
     std::mt19937_64 rng(6);
     nlohmann::json in{{"model", h.to_json()}, {"sequences", nlohmann::json::array()}};

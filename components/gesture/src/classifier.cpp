@@ -95,13 +95,13 @@ Models train_models(const std::vector<const Clip*>& clips, const ClassMap& map, 
     t.constant_spread = shared_spread;
     if (m.cls[iu] == map.garbage_index() && o.garbage_mixtures > 0) t.mixtures = o.garbage_mixtures;
     t.seed = o.hmm.seed + static_cast<std::uint64_t>(i);
-    m.hmms[iu] = Hmm::train(*data[iu], t);
+    m.hmms[iu] = GaussianHmm::train(*data[iu], t);
   });
   return m;
 }
 
 // Per class: the best log-likelihood per frame of its models.
-Decision decide(const std::vector<Hmm>& hmms, const std::vector<int>& cls, int classes, const Sequence& raw, Hands hands,
+Decision decide(const std::vector<GaussianHmm>& hmms, const std::vector<int>& cls, int classes, const Sequence& raw, Hands hands,
                 FeatureSet set, double threshold, int garbage) {
   const Sequence x = prepared(raw, hands, set);
   Decision d;
@@ -260,7 +260,7 @@ Classifier Classifier::from_json(const nlohmann::json& j) {
     const int k = e["class"].get<int>();
     if (k < 0 || k >= K) throw ModelError(where + ": 'class' " + std::to_string(k) + " is not a label index");
     try {
-      c.models_.push_back(Hmm::from_json(e["hmm"]));
+      c.models_.push_back(GaussianHmm::from_json(e["hmm"]));
     } catch (const ModelError& err) {
       throw ModelError(where + " (" + c.labels_[static_cast<std::size_t>(k)] + "): " + err.what());
     }

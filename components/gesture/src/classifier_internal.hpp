@@ -22,7 +22,7 @@ double quantile(std::vector<double> v, double q);
 Sequence prepared(const Sequence& x, Hands hands, FeatureSet set);
 
 struct Models {
-  std::vector<Hmm> hmms;
+  std::vector<GaussianHmm> hmms;
   std::vector<int> cls;             // class of each model
   std::vector<std::string> action;  // action it was trained on ("" when per class)
 };
@@ -31,7 +31,7 @@ struct Models {
 Models train_models(const std::vector<const Clip*>& clips, const ClassMap& map, const ClassifierOptions& o);
 
 // Per class: the best log-likelihood per frame of its models.
-Decision decide(const std::vector<Hmm>& hmms, const std::vector<int>& cls, int classes, const Sequence& raw, Hands hands,
+Decision decide(const std::vector<GaussianHmm>& hmms, const std::vector<int>& cls, int classes, const Sequence& raw, Hands hands,
                 FeatureSet set, double threshold, int garbage);
 
 }  // namespace skelgraph::gesture::detail

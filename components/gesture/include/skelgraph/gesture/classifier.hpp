@@ -17,7 +17,7 @@
 
 #include "skelgraph/gesture/class_map.hpp"
 #include "skelgraph/gesture/features.hpp"
-#include "skelgraph/gesture/hmm.hpp"
+#include "skelgraph/gesture/gaussian_mixture.hpp"
 #include "skelgraph/gesture/metrics.hpp"
 
 namespace skelgraph::gesture {
@@ -89,7 +89,7 @@ class Classifier {
   int garbage_index() const { return garbage_; }
   double threshold() const { return threshold_; }
   void set_threshold(double t) { threshold_ = t; }
-  const std::vector<Hmm>& models() const { return models_; }
+  const std::vector<GaussianHmm>& models() const { return models_; }
   const std::vector<int>& model_classes() const { return model_class_; }  // the class of each model
   FeatureSet feature_set() const { return features_; }
   Hands hands() const { return hands_; }
@@ -107,7 +107,7 @@ class Classifier {
 
  private:
   std::vector<std::string> labels_;
-  std::vector<Hmm> models_;
+  std::vector<GaussianHmm> models_;
   std::vector<int> model_class_;
   std::vector<std::string> model_action_;
   int garbage_ = -1;
