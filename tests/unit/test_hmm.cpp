@@ -3,7 +3,7 @@
 // emissions far from the origin against the Gaussians evaluated directly,
 // no underflow on long sequences, streaming equals batch, Baum-Welch raises
 // the likelihood and finds the generating model's states, save/load and
-// malformed models.
+// malformed models; the same HMM over a categorical emission model.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -530,6 +530,197 @@ TEST(Hmm, SaveLoadAndMalformedModels) {
   EXPECT_THROW(GaussianHmm::train({}, o), ModelError);
   EXPECT_THROW(GaussianHmm::train({MatrixXd::Zero(5, 2), MatrixXd::Zero(5, 3)}, o), ModelError);
   EXPECT_THROW(h.log_likelihood(MatrixXd::Zero(4, 3)), ModelError);
+}
+
+// --- Another emission model: Hmm<> over categorical emissions ---
+
+namespace {
+
+// One categorical distribution per state over a single feature whose values
+// are the symbols 0..K-1 (any other value is impossible): an emission model
+// written here, to show Hmm<> takes any that meets hmm.hpp's requirements.
+class Categorical {
+ public:
+  struct Workspace {};
+  class Trainer;
+
+  Categorical() = default;
+  explicit Categorical(MatrixXd p) : p_(std::move(p)), log_p_(p_.array().log().matrix()) {}  // N x K, rows sum to 1
+  int states() const { return static_cast<int>(p_.rows()); }
+  int dim() const { return 1; }
+  const MatrixXd& p() const { return p_; }
+
+  void log_probabilities(const Sequence& x, Workspace&, Eigen::Ref<Rows> logb) const {
+    for (Eigen::Index t = 0; t < x.rows(); ++t) logb.row(t) = log_p(x(t, 0)).transpose();
+  }
+  void log_probabilities(const VectorXd& x, Eigen::Ref<VectorXd> logb) const { logb = log_p(x(0)); }
+
+  void to_json(nlohmann::json& model) const {
+    nlohmann::json rows = nlohmann::json::array();
+    for (Eigen::Index j = 0; j < p_.rows(); ++j) {
+      const VectorXd row = p_.row(j).transpose();
+      rows.push_back(std::vector<double>(row.data(), row.data() + row.size()));
+    }
+    model["categorical"] = rows;
+  }
+  static Categorical from_json(const nlohmann::json& model, int states, int dim) {
+    const auto& rows = model.at("categorical");
+    if (dim != 1 || static_cast<int>(rows.size()) != states) throw ModelError("categorical: one feature, a row per state");
+    MatrixXd p(states, static_cast<Eigen::Index>(rows.at(0).size()));
+    for (int j = 0; j < states; ++j) {
+      const auto row = rows.at(static_cast<std::size_t>(j)).get<std::vector<double>>();
+      p.row(j) = Eigen::Map<const Eigen::RowVectorXd>(row.data(), static_cast<Eigen::Index>(row.size()));
+    }
+    return Categorical(p);
+  }
+
+ private:
+  VectorXd log_p(double v) const {
+    const auto k = static_cast<Eigen::Index>(v);
+    if (static_cast<double>(k) != v || k < 0 || k >= p_.cols()) return VectorXd::Constant(p_.rows(), -INFINITY);
+    return log_p_.col(k);
+  }
+  MatrixXd p_, log_p_;
+};
+
+// Add-one counts per state for the first emissions, expected counts (sums of
+// posteriors) for each next.
+class Categorical::Trainer {
+ public:
+  Trainer(const std::vector<Sequence>& data, const TrainOptions& o) : N_(o.states) {
+    for (const auto& x : data) {
+      first_.push_back(static_cast<Eigen::Index>(symbols_.size()));
+      for (Eigen::Index t = 0; t < x.rows(); ++t) {
+        if (x(t, 0) != std::floor(x(t, 0)) || x(t, 0) < 0) throw ModelError("categorical: symbols are 0, 1, 2, ...");
+        symbols_.push_back(static_cast<Eigen::Index>(x(t, 0)));
+      }
+    }
+    counts_ = MatrixXd::Zero(N_, *std::max_element(symbols_.begin(), symbols_.end()) + 1);
+  }
+  Categorical initialise(const std::vector<int>& state, std::mt19937_64&) {
+    MatrixXd c = MatrixXd::Ones(N_, counts_.cols());
+    for (std::size_t f = 0; f < symbols_.size(); ++f) c(state[f], symbols_[f]) += 1;
+    return Categorical(c.array().colwise() / c.rowwise().sum().array());
+  }
+  const Rows& log_probabilities(const Categorical& e) {
+    logb_.resize(static_cast<Eigen::Index>(symbols_.size()), N_);
+    for (std::size_t f = 0; f < symbols_.size(); ++f) logb_.row(static_cast<Eigen::Index>(f)) = e.log_p_.col(symbols_[f]).transpose();
+    return logb_;
+  }
+  void accumulate(std::size_t s, const Eigen::Ref<const Rows>& gamma) {
+    for (Eigen::Index t = 0; t < gamma.rows(); ++t) {
+      counts_.col(symbols_[static_cast<std::size_t>(first_[s] + t)]) += gamma.row(t).transpose();
+    }
+  }
+  Categorical finish(const Categorical& e, std::mt19937_64&) {
+    MatrixXd p = e.p();
+    for (int j = 0; j < N_; ++j) {
+      if (counts_.row(j).sum() > 0) p.row(j) = counts_.row(j) / counts_.row(j).sum();  // else as it was
+    }
+    counts_.setZero();
+    return Categorical(p);
+  }
+
+ private:
+  const int N_;
+  std::vector<Eigen::Index> symbols_, first_;
+  MatrixXd counts_;
+  Rows logb_;
+};
+
+static_assert(is_emission_v<Categorical> && is_emission_v<GaussianMixtureEmission>);
+static_assert(!is_emission_v<GaussianMixture> && !is_emission_v<Eigen::MatrixXd>);
+
+}  // namespace
+
+// A known two-state categorical model: forward, Viterbi, posteriors and the
+// streaming step against brute force over every path of a short sequence;
+// Baum-Welch on samples of it finds it again; save and load.
+TEST(Hmm, ACategoricalEmissionPlugsIn) {
+  VectorXd start(2);
+  start << 0.7, 0.3;
+  MatrixXd a(2, 2), p(2, 3);
+  a << 0.9, 0.1, 0.2, 0.8;
+  p << 0.7, 0.2, 0.1, 0.1, 0.3, 0.6;
+  Hmm<Categorical> truth;
+  truth.set(start, a, Categorical(p));
+  Sequence x(7, 1);
+  x << 0, 2, 2, 1, 0, 2, 1;
+  double total = 0, best = -1;
+  MatrixXd joint = MatrixXd::Zero(7, 2);
+  std::vector<int> path(7), best_path;
+  std::function<void(int, double)> walk = [&](int t, double pr) {
+    if (t == 7) {
+      total += pr;
+      if (pr > best) best = pr, best_path = path;
+      for (int u = 0; u < 7; ++u) joint(u, path[static_cast<std::size_t>(u)]) += pr;
+      return;
+    }
+    for (int s = 0; s < 2; ++s) {
+      path[static_cast<std::size_t>(t)] = s;
+      const double step = t == 0 ? start(s) : a(path[static_cast<std::size_t>(t - 1)], s);
+      walk(t + 1, pr * step * p(s, static_cast<Eigen::Index>(x(t, 0))));
+    }
+  };
+  walk(0, 1.0);
+  EXPECT_NEAR(truth.log_likelihood(x), std::log(total), 1e-12);
+  double lp = 0;
+  EXPECT_EQ(truth.viterbi(x, &lp), best_path);
+  EXPECT_NEAR(lp, std::log(best), 1e-12);
+  EXPECT_LT((truth.posteriors(x) - joint / total).cwiseAbs().maxCoeff(), 1e-12);
+  Hmm<Categorical>::Stream stream(truth);
+  double streamed = 0;
+  for (Eigen::Index t = 0; t < x.rows(); ++t) streamed = stream.step(x.row(t).transpose());
+  EXPECT_NEAR(streamed, std::log(total), 1e-12);
+  Sequence impossible = x;
+  impossible(3, 0) = 5;
+  EXPECT_EQ(truth.log_likelihood(impossible), -INFINITY);
+
+  // Training from samples finds the model again (states in either order).
+  std::mt19937_64 rng(21);
+  const auto draw = [&](const VectorXd& pr) {
+    double r = std::uniform_real_distribution<double>(0, 1)(rng);
+    for (Eigen::Index i = 0; i + 1 < pr.size(); ++i) {
+      if ((r -= pr(i)) <= 0) return static_cast<int>(i);
+    }
+    return static_cast<int>(pr.size() - 1);
+  };
+  std::vector<Sequence> data;
+  for (int i = 0; i < 200; ++i) {
+    Sequence y(60, 1);
+    int s = draw(start);
+    for (int t = 0; t < 60; ++t) {
+      if (t > 0) s = draw(a.row(s).transpose());
+      y(t, 0) = draw(p.row(s).transpose());
+    }
+    data.push_back(y);
+  }
+  TrainOptions o;
+  o.states = 2;
+  o.init = Init::KMeans;
+  o.tolerance = 1e-9;
+  o.max_iterations = 500;
+  TrainReport rep;
+  const auto h = Hmm<Categorical>::train(data, o, &rep);
+  EXPECT_TRUE(rep.converged);
+  for (std::size_t i = 1; i < rep.log_likelihood.size(); ++i) {
+    EXPECT_GE(rep.log_likelihood[i], rep.log_likelihood[i - 1] - 1e-9 * std::abs(rep.log_likelihood[i - 1])) << i;
+  }
+  const int first = h.emission().p()(0, 0) > h.emission().p()(1, 0) ? 0 : 1;  // the state that mostly emits 0
+  const std::array<int, 2> order{first, 1 - first};
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_NEAR(h.start()(order[i]), start(i), 0.1) << i;
+    for (int j = 0; j < 2; ++j) EXPECT_NEAR(h.transitions()(order[i], order[j]), a(i, j), 0.03) << i << j;
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(h.emission().p()(order[i], k), p(i, k), 0.03) << i << k;
+  }
+  double ll_truth = 0, ll_fit = 0;
+  for (const auto& y : data) ll_truth += truth.log_likelihood(y), ll_fit += h.log_likelihood(y);
+  EXPECT_NEAR(ll_fit, rep.log_likelihood.back(), 1e-9 * std::abs(ll_fit));
+  EXPECT_GE(ll_fit, ll_truth);  // the maximum likelihood fit of this very data
+
+  const auto back = Hmm<Categorical>::from_json(nlohmann::json::parse(h.to_json().dump()));
+  EXPECT_EQ(back.to_json(), h.to_json());
+  EXPECT_DOUBLE_EQ(back.log_likelihood(x), h.log_likelihood(x));
 }
 
 // --- Peer check: pomegranate (an independent implementation) on the same model ---
