@@ -11,6 +11,7 @@
 #include "skelgraph/calib/calib_file.hpp"
 #include "skelgraph/calib/inputs.hpp"
 #include "skelgraph/calib/sim_check.hpp"
+#include "skelgraph/calib/skeleton_run.hpp"
 #include "skelgraph/msg/messages.hpp"
 #include "skelgraph/recording/bag.hpp"
 #include "skelgraph/skeleton/skeleton_msg.hpp"
@@ -177,4 +178,56 @@ TEST(CalibFile, ATransformFromItsOwnFileOrACalibrationFile) {
     EXPECT_NE(std::string(e.what()).find("no sensor 'vicon'"), std::string::npos) << e.what();
   }
   std::filesystem::remove(path);
+}
+
+// calib skeleton's report (calib/skeleton_run.hpp): a simulated pair placed
+// near its truth and accepted, the held-out half checked; three sensors make
+// the whole cell's report; a sensor the input lacks is named with the input.
+TEST(CalibSkeletonRun, APairAndACellFromSimulatedSkeletons) {
+  const auto input = [](int sensors) {
+    sim::SimConfig cfg;
+    cfg.scenario.name = "walk";
+    cfg.scenario.repeats = 2;
+    cfg.sensors = sim::default_sensors(sensors);
+    sim::Simulation sim(cfg);
+    calib::SkeletonInput in;
+    for (auto& e : sim.advance(sim.duration())) {
+      if (e.kind == sim::SimEvent::Kind::Raw) in.by_sensor[e.skeleton.sensor_id].push_back({e.skeleton.stamp_ns, e.skeleton});
+    }
+    return std::pair{in, cfg};
+  };
+  auto [pair_in, pair_cfg] = input(2);
+  calib::SkeletonRun run;
+  run.ref = "sensor1";
+  run.holdout = true;
+  std::vector<skeleton::SensorPose> poses;
+  const auto j = calib::calibrate_skeletons("walk", pair_in, run, &poses);
+  EXPECT_EQ(j["other"], "sensor2");
+  EXPECT_TRUE(j["improved"].get<bool>()) << j["verdict"];
+  EXPECT_LT(j["held_out_median_distance_cm"]["after"].get<double>(), j["held_out_median_distance_cm"]["before"].get<double>());
+  ASSERT_EQ(poses.size(), 1u);
+  EXPECT_EQ(poses[0].method, "skeleton");
+  const Eigen::Isometry3d truth = pair_cfg.sensors[0].world_from_sensor().inverse() * pair_cfg.sensors[1].world_from_sensor();
+  const auto err = calib::pose_error(poses[0].pose, truth);
+  EXPECT_LT(err.cm, 5.0);
+  EXPECT_LT(err.deg, 2.0);
+  EXPECT_EQ(calib::pose_json(truth)["translation_m"].size(), 3u);
+  EXPECT_EQ(calib::cm(0.12345), 12.3);
+
+  auto [cell_in, cell_cfg] = input(3);
+  poses.clear();
+  run.holdout = false;
+  const auto c = calib::calibrate_skeletons("cell", cell_in, run, &poses);
+  EXPECT_EQ(c["mode"], "cell");
+  EXPECT_EQ(c["sensors"].size(), 2u);
+  EXPECT_EQ(c["unplaced"], 0);
+  EXPECT_EQ(poses.size(), 2u);
+
+  run.ref = "sensor9";
+  try {
+    calib::calibrate_skeletons("walk.mcap", pair_in, run, nullptr);
+    FAIL() << "a reference the input lacks was taken";
+  } catch (const calib::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("walk.mcap: no skeletons of reference sensor 'sensor9'"), std::string::npos) << e.what();
+  }
 }

@@ -11,15 +11,6 @@
 namespace skelgraph::cli {
 namespace calib_cmd {
 
-nlohmann::json pose_json(const Eigen::Isometry3d& T) {
-  const Eigen::Quaterniond q(T.rotation());
-  return {{"translation_m", {T.translation().x(), T.translation().y(), T.translation().z()}},
-          {"rotation_xyzw", {q.x(), q.y(), q.z(), q.w()}},
-          {"rotation_deg", calib::rotation_angle_deg(T.rotation())}};
-}
-
-double cm(double m) { return std::isfinite(m) ? std::round(m * 1000.0) / 10.0 : m; }
-
 // The reference sensor's pose in the world: from a calibration file, or the
 // identity (the reference's frame is the world) without one.
 Eigen::Isometry3d reference_in_world(const std::string& file, const std::string& ref) {

@@ -14,6 +14,7 @@
 #include "cli.hpp"
 #include "skelgraph/calib/board.hpp"
 #include "skelgraph/calib/calib_file.hpp"
+#include "skelgraph/calib/skeleton_run.hpp"
 
 namespace skelgraph::cli::calib_cmd {
 
@@ -66,8 +67,8 @@ int calib_intrinsics(const BoardOptions& o);
 int calib_board(const BoardOptions& o);
 int calib_robot(const RobotOptions& o);
 
-nlohmann::json pose_json(const Eigen::Isometry3d& T);
-double cm(double m);  // metres to centimetres, rounded to mm
+using calib::cm;         // metres to centimetres, rounded to mm
+using calib::pose_json;  // translation_m, rotation_xyzw, rotation_deg
 // The reference sensor's pose in the world: from a calibration file, or the
 // identity (the reference's frame is the world) without one.
 Eigen::Isometry3d reference_in_world(const std::string& file, const std::string& ref);

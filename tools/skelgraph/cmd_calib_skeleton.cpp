@@ -1,32 +1,20 @@
 // skelgraph calib skeleton: sensor extrinsics from the skeletons the sensors
 // report of the same people (no board), one pair or the whole cell, with
-// residuals, a hold-out check, a verdict and a file fusion can use. The
-// calibration step and its acceptance policy are calib/calibration_step.hpp.
+// residuals, a hold-out check, a verdict and a file fusion can use
+// (calib/skeleton_run.hpp; the step and its acceptance policy:
+// calib/calibration_step.hpp).
 
-#include <algorithm>
-#include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <map>
-#include <optional>
+#include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "cmd_calib.hpp"
-#include "skelgraph/calib/board.hpp"
-#include "skelgraph/skeleton/json_number.hpp"
-#include "skelgraph/skeleton/stats.hpp"
 #include "skelgraph/calib/calib_file.hpp"
-#include "skelgraph/calib/calibration_step.hpp"
 #include "skelgraph/calib/inputs.hpp"
-#include "skelgraph/calib/sim_check.hpp"
-#include "skelgraph/calib/skeleton_calib.hpp"
-#include "skelgraph/eval/metrics.hpp"
+#include "skelgraph/calib/skeleton_run.hpp"
 #include "skelgraph/playback/readers.hpp"
-#include "skelgraph/robot/robot_component.hpp"
-#include "skelgraph/runtime/topics.hpp"
-#include "skelgraph/sim/simulation.hpp"
-#include "skelgraph/skeleton/skeleton_msg.hpp"
 
 namespace skelgraph::cli::calib_cmd {
 
@@ -44,119 +32,7 @@ Input read_input(const std::string& path, const std::string& format, const std::
   }
 }
 
-// What a result says when the skeletons could not tell on which side of the person a sensor is.
-const char* const kUndecided =
-    "ambiguous: the person hardly moved about (turned on the spot?), so the skeletons cannot tell on which side of "
-    "them the sensor is, and nothing decided: kept the previous pose (the fit's guess, the side where both sensors "
-    "see the front more often, is in the JSON). Walk a loop facing where you go, or give the rough layout with --prior";
-
-// The upper body as evaluation scores it, group by group (head, neck, torso, shoulders, elbows, hands).
-std::vector<skeleton::JointId> upper_body() {
-  std::vector<skeleton::JointId> upper;
-  for (int g = 0; g < static_cast<int>(eval::kGroupCount); ++g)
-    for (std::size_t k = 0; k < skeleton::kJointCount; ++k)
-      if (eval::group_of(skeleton::joint_at(k)) == g) upper.push_back(skeleton::joint_at(k));
-  return upper;
-}
-
-// Every sensor of one input at once (no --other and more than one other sensor).
-nlohmann::json calibrate_cell_input(const std::string& path, const SkelOptions& o, const Input& in,
-                                    std::vector<skeleton::SensorPose>* result) {
-  calib::SensorSkeletons fit = in.by_sensor, test;
-  if (o.holdout) {
-    auto halves = calib::split_halves(in.by_sensor, o.ref);
-    fit = std::move(halves.fit), test = std::move(halves.test);
-  }
-  // The poses the input already implies (a shared frame when it has none).
-  calib::SensorPoses before;
-  for (const auto& [id, v] : in.by_sensor) {
-    before[id] = in.poses.count(o.ref) && in.poses.count(id) ? Eigen::Isometry3d(in.poses.at(o.ref).inverse() * in.poses.at(id))
-                                                             : Eigen::Isometry3d::Identity();
-  }
-  calib::CellCalibOptions co;
-  co.pair.inlier_threshold_m = o.threshold_m;
-  co.pair.robust_scale_m = o.robust_scale_m;
-  co.prior = in.poses;
-  calib::CellStep step;
-  try {
-    step = calib::calibrate_cell_step(fit, o.ref, before, co);
-  } catch (const calib::CalibError& e) {
-    throw UsageError(path + ": cannot calibrate the cell against " + o.ref + ": " + e.what());
-  }
-  const auto& r = step.fit;
-  const auto& chosen = step.chosen;
-  const auto upper = upper_body();
-  nlohmann::json j{{"input", path}, {"reference", o.ref}, {"mode", "cell"}, {"joint_solution_rounds", r.rounds}};
-  auto& sensors = j["sensors"] = nlohmann::json::array();
-  std::size_t unplaced = 0, undecided = 0;
-  for (const auto& s : r.sensors) {
-    if (s.id == o.ref) continue;
-    nlohmann::json sj{{"sensor", s.id}, {"frames", in.by_sensor.at(s.id).size()}, {"placed", s.placed}};
-    if (!s.placed) {
-      ++unplaced;
-      sj["verdict"] = "not placed: it shares too few views with any placed sensor; kept the previous pose";
-      sj["improved"] = false;
-      sensors.push_back(sj);
-      continue;
-    }
-    // Never worse than before, sensor by sensor, on the data it was fitted to.
-    const auto& acc = step.acceptance.at(s.id);
-    const bool improved = acc.improved;
-    sj["path"] = s.path;
-    sj["reference_from_sensor"] = pose_json(s.reference_from_sensor);
-    sj["joint_pairs"] = s.pairs;
-    sj["median_distance_cm"] = json_number(cm(s.median_m));
-    sj["rms_residual_cm"] = json_number(cm(s.rms_m));
-    sj["max_residual_cm"] = json_number(cm(s.max_m));
-    sj["fit_median_distance_cm"] = {{"before", json_number(cm(acc.before_m))}, {"after", json_number(cm(acc.after_m))}};
-    sj["improved"] = improved;
-    sj["undecided"] = s.ambiguous;
-    if (s.ambiguous) ++undecided;
-    sj["verdict"] = s.ambiguous ? kUndecided
-                    : improved  ? "calibrated: brings its skeletons closer to the other sensors' than before"
-                                : "kept the previous pose: the fit did not bring its skeletons closer on the data it saw";
-    sensors.push_back(sj);
-  }
-  if (o.holdout) {
-    for (auto& sj : sensors) {
-      const auto id = sj["sensor"].get<std::string>();
-      sj["held_out_median_distance_cm"] = {{"before", json_number(cm(calib::cell_median(test, id, before, upper)))},
-                                           {"after", json_number(cm(calib::cell_median(test, id, chosen, upper)))}};
-    }
-  }
-  auto& links = j["links"] = nlohmann::json::array();
-  for (const auto& l : r.links) {
-    nlohmann::json lj{{"a", l.a}, {"b", l.b}, {"solved", l.solved}, {"in_tree", l.in_tree}, {"joint_pairs", l.pairs},
-                      {"mirrored_frames", l.mirrored}, {"median_distance_cm", json_number(cm(l.median_m))}};
-    if (l.solved) {
-      lj["ambiguous"] = l.fit.ambiguous;
-      lj["resolved_by_prior"] = l.fit.resolved_by_prior;
-      lj["person_spread_cm"] = cm(l.fit.person_spread_m);
-    }
-    if (!l.solved) lj["error"] = l.error;
-    links.push_back(lj);
-  }
-  j["unplaced"] = unplaced;
-  j["undecided"] = undecided;
-  if (result != nullptr) {
-    for (const auto& sj : sensors) {
-      skeleton::SensorPose p;
-      p.sensor_id = sj["sensor"].get<std::string>();
-      p.pose = chosen.at(p.sensor_id);
-      p.method = sj["improved"].get<bool>() ? "skeleton (cell)" : "unchanged";
-      if (sj["improved"].get<bool>()) {
-        // Its joint pairs' residuals under the joint solution.
-        const auto* s = r.sensor(p.sensor_id);
-        p.rms_residual_m = std::isfinite(s->rms_m) ? s->rms_m : 0.0;
-        p.max_residual_m = s->max_m;
-      }
-      result->push_back(p);
-    }
-  }
-  return j;
-}
-
-// One input: fit (on the first half with --holdout), check, and the verdict.
+// One input: its skeletons, the previous poses (--prior), then calib::calibrate_skeletons.
 nlohmann::json calibrate_one(const std::string& path, const SkelOptions& o, std::vector<skeleton::SensorPose>* results) {
   Input in = read_input(path, o.format, o.on_error);
   if (o.prior == "shared") {
@@ -164,98 +40,20 @@ nlohmann::json calibrate_one(const std::string& path, const SkelOptions& o, std:
   } else if (!o.prior.empty()) {
     in.poses = prior_poses(o.prior);
   }
-  std::string names;
-  for (const auto& [id, v] : in.by_sensor) names += (names.empty() ? "" : ", ") + id + " (" + std::to_string(v.size()) + ")";
-  if (!in.by_sensor.count(o.ref)) throw UsageError(path + ": no skeletons of reference sensor '" + o.ref + "'; sensors: " + names);
-  std::string other = o.other;
-  if (other.empty()) {
-    if (in.by_sensor.size() > 2) return calibrate_cell_input(path, o, in, results);
-    for (const auto& [id, v] : in.by_sensor)
-      if (id != o.ref) other = id;
-    if (other.empty()) throw UsageError(path + ": only the reference sensor has skeletons (" + names + ")");
-  } else if (!in.by_sensor.count(other)) {
-    throw UsageError(path + ": no skeletons of sensor '" + other + "'; sensors: " + names);
-  }
-  const auto& ref = in.by_sensor.at(o.ref);
-  const auto& oth = in.by_sensor.at(other);
-  // The pose the input already implies (a shared frame when it has none).
-  Eigen::Isometry3d before = Eigen::Isometry3d::Identity();
-  if (in.poses.count(o.ref) && in.poses.count(other)) before = in.poses.at(o.ref).inverse() * in.poses.at(other);
-
-  std::vector<calib::TimedSkeleton> fit_ref = ref, fit_oth = oth, test_ref, test_oth;
-  if (o.holdout) {
-    auto [fit, test] = calib::split_halves(in.by_sensor, o.ref);
-    fit_ref = fit[o.ref], fit_oth = fit[other], test_ref = test[o.ref], test_oth = test[other];
-  }
-  calib::SkeletonCalibOptions co;
-  co.inlier_threshold_m = o.threshold_m;
-  co.robust_scale_m = o.robust_scale_m;
-  co.max_clock_offset_ns = static_cast<std::int64_t>(o.clock_search_ms * 1e6);
-  if (in.poses.count(o.ref) && in.poses.count(other)) co.prior = before;
-  calib::PairStep step;
+  calib::SkeletonRun run;
+  run.ref = o.ref;
+  run.other = o.other;
+  run.threshold_m = o.threshold_m;
+  run.robust_scale_m = o.robust_scale_m;
+  run.clock_search_ms = o.clock_search_ms;
+  run.holdout = o.holdout;
+  run.best_rigid = o.best_rigid;
+  run.best_rigid_starts = o.best_rigid_starts;
   try {
-    step = calib::calibrate_pair_step(fit_ref, fit_oth, before, co);
-  } catch (const calib::CalibError& e) {
-    throw UsageError(path + ": cannot calibrate " + other + " against " + o.ref + ": " + e.what());
+    return calib::calibrate_skeletons(path, in, run, results);
+  } catch (const calib::InputError& e) {
+    throw UsageError(e.what());
   }
-  // Never worse than before: judged on the data it was fitted to (the held-out half stays unseen).
-  const auto& r = step.fit;
-  const bool undecided = step.acceptance.undecided, improved = step.acceptance.improved;
-  const Eigen::Isometry3d chosen = step.chosen;
-  const std::int64_t chosen_offset = step.chosen_offset_ns;
-
-  nlohmann::json j{{"input", path},
-                   {"reference", o.ref},
-                   {"other", other},
-                   {"frames", {{o.ref, ref.size()}, {other, oth.size()}}},
-                   {"reference_from_other", pose_json(r.fit.transform())},
-                   {"clock_offset_ms", r.clock_offset_ns / 1e6},
-                   {"matched_frames", r.matched},
-                   {"mirrored_frames", r.mirrored},
-                   {"person_spread_cm", cm(r.person_spread_m)},
-                   {"turned_round_inliers", r.turned_inliers},
-                   {"ambiguous", r.ambiguous},
-                   {"resolved_by_prior", r.resolved_by_prior},
-                   {"undecided", undecided},
-                   {"joint_pairs", r.pairs},
-                   {"inliers", r.inliers},
-                   {"rms_residual_cm", cm(r.fit.rms)},
-                   {"max_residual_cm", cm(r.fit.max)},
-                   {"fit_median_distance_cm",
-                    {{"before", json_number(cm(step.acceptance.before_m))}, {"after", json_number(cm(step.acceptance.after_m))}}}};
-  nlohmann::json per = nlohmann::json::object();
-  for (const auto& jr : r.per_joint) {
-    per[skeleton::joint_name(jr.joint)] = {{"pairs", jr.pairs}, {"median_cm", json_number(cm(jr.median_m))}, {"rms_cm", json_number(cm(jr.rms_m))}};
-  }
-  j["per_joint"] = per;
-  if (o.holdout) {
-    const auto upper = upper_body();
-    const double b = stats::upper_median(calib::joint_distances(test_ref, test_oth, before, 0, upper, 2.0));
-    const double a = stats::upper_median(calib::joint_distances(test_ref, test_oth, chosen, chosen_offset, upper, 2.0));
-    j["held_out_median_distance_cm"] = {{"before", json_number(cm(b))}, {"after", json_number(cm(a))}};
-    if (o.best_rigid) {
-      // The floor: the best rigid pose found near the chosen one for the held-out half itself.
-      const auto floor = calib::lowest_median_pose(test_ref, test_oth, chosen, chosen_offset, upper, 2.0, o.best_rigid_starts);
-      j["held_out_best_rigid_median_cm"] = json_number(cm(floor.median_m));
-      j["held_out_best_rigid_starts"] = floor.starts;
-    }
-    auto& held_out = j["held_out_joints"] = nlohmann::json::array();
-    for (auto jid : upper) held_out.push_back(skeleton::joint_name(jid));
-  }
-  j["verdict"] = undecided ? kUndecided
-                : improved ? "calibrated: the fitted pose brings the sensors' skeletons closer than before"
-                           : "kept the previous pose: the fit did not bring the skeletons closer on the data it saw";
-  j["improved"] = improved;
-  if (results != nullptr) {
-    skeleton::SensorPose p;
-    p.sensor_id = other;
-    p.pose = chosen;
-    p.method = improved ? "skeleton" : "unchanged";
-    p.rms_residual_m = r.fit.rms;
-    p.max_residual_m = r.fit.max;
-    results->push_back(p);
-  }
-  return j;
 }
 
 }  // namespace
