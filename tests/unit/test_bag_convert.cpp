@@ -4,6 +4,8 @@
 // truth at the recording's start.
 #include <gtest/gtest.h>
 
+#include "../support/temp_dir.hpp"
+
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -16,11 +18,6 @@ using namespace skelgraph;
 namespace fs = std::filesystem;
 
 namespace {
-fs::path fresh(const std::string& name) {
-  const auto d = fs::path(::testing::TempDir()) / name;
-  fs::remove_all(d);
-  return d;
-}
 playback::Recording walk(const std::string& sensor, std::int64_t t0, int frames) {
   playback::Recording r;
   r.format = "generic";
@@ -47,7 +44,7 @@ std::string write_csv(const fs::path& path, const playback::Recording& r) {
 }  // namespace
 
 TEST(BagConvert, ImportedSkeletonsExportUnchanged) {
-  const auto dir = fresh("bag_convert");
+  const auto dir = test::fresh_path("bag_convert");
   fs::create_directories(dir);
   const auto a = write_csv(dir / "a.csv", walk("kinect_a", 1'000'000'000, 30));
   const auto b = write_csv(dir / "b.csv", walk("kinect_b", 1'010'000'000, 20));
@@ -82,7 +79,7 @@ TEST(BagConvert, ImportedSkeletonsExportUnchanged) {
 }
 
 TEST(BagConvert, ANegativeStampIsRefusedNamingTheFile) {
-  const auto dir = fresh("bag_convert_negative");
+  const auto dir = test::fresh_path("bag_convert_negative");
   fs::create_directories(dir);
   const auto f = write_csv(dir / "early.csv", walk("s", -100'000'000, 5));
   try {
@@ -94,7 +91,7 @@ TEST(BagConvert, ANegativeStampIsRefusedNamingTheFile) {
 }
 
 TEST(BagConvert, MocapIsAddedAsTheTruthAtTheRecordingsStart) {
-  const auto dir = fresh("bag_convert_mocap");
+  const auto dir = test::fresh_path("bag_convert_mocap");
   fs::create_directories(dir);
   const auto f = write_csv(dir / "a.csv", walk("kinect_a", 5'000'000'000, 30));
   recording::import_skeletons(playback::Format::Generic, {f}, {}, (dir / "rec.mcap").string(), mcap::Compression::Zstd);

@@ -4,6 +4,8 @@
 // and tokens (added, then revoked).
 #include <gtest/gtest.h>
 
+#include "../support/temp_dir.hpp"
+
 #include <filesystem>
 #include <fstream>
 
@@ -13,11 +15,6 @@ using namespace skelgraph::runtime::security;
 namespace fs = std::filesystem;
 
 namespace {
-fs::path fresh(const std::string& name) {
-  const auto d = fs::path(::testing::TempDir()) / name;
-  fs::remove_all(d);
-  return d;
-}
 bool check_passed(const nlohmann::json& out, const std::string& what) {
   for (const auto& c : out["checks"]) {
     if (c["check"].get<std::string>().find(what) != std::string::npos) return c["ok"].get<bool>();
@@ -45,7 +42,7 @@ TEST(Credentials, HostsAndRolesAreCheckedFirst) {
 }
 
 TEST(Credentials, AMadeCellChecksRightAndATamperedOneDoesNot) {
-  const auto dir = fresh("cell_credentials").string();
+  const auto dir = skelgraph::test::fresh_path("cell_credentials").string();
   CellSpec spec;
   spec.master = "fusion-pc";
   spec.sensors = {"cam-1"};
@@ -81,7 +78,7 @@ TEST(Credentials, AMadeCellChecksRightAndATamperedOneDoesNot) {
 }
 
 TEST(Credentials, TheViewersCertificatesAndTokens) {
-  const auto dir = fresh("viewer_credentials").string();
+  const auto dir = skelgraph::test::fresh_path("viewer_credentials").string();
   ViewerCertSpec server;
   server.server = "fusion-pc";
   EXPECT_THROW(make_viewer_certificate(dir, server), CredentialsError);  // no cell CA yet

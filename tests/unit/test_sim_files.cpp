@@ -5,6 +5,8 @@
 // the refusal of a robot that cannot show a sensor the board.
 #include <gtest/gtest.h>
 
+#include "../support/temp_dir.hpp"
+
 #include <filesystem>
 
 #include "skelgraph/calib/sim_boards.hpp"
@@ -17,11 +19,6 @@ using namespace skelgraph;
 namespace fs = std::filesystem;
 
 namespace {
-fs::path fresh_dir(const std::string& name) {
-  const auto d = fs::path(::testing::TempDir()) / name;
-  fs::remove_all(d);
-  return d;
-}
 sim::SimConfig short_walk() {
   sim::SimConfig cfg;
   cfg.scenario.name = "walk";
@@ -30,7 +27,7 @@ sim::SimConfig short_walk() {
 }  // namespace
 
 TEST(SimFiles, ExportWritesEveryFrameOfTheTruthAndEachSensor) {
-  const auto dir = fresh_dir("sim_export");
+  const auto dir = test::fresh_path("sim_export");
   int calls = 0;
   double last_done = 0, total = 0;
   const auto s = sim::export_simulation(short_walk(), dir.string(), [&](double done, double all) {
@@ -54,7 +51,7 @@ TEST(SimFiles, ExportWritesEveryFrameOfTheTruthAndEachSensor) {
 }
 
 TEST(SimFiles, HandAtToolRecordsTheToolWhereTheHandIs) {
-  const auto out = (fresh_dir("hand_at_tool") += ".mcap").string();
+  const auto out = (test::fresh_path("hand_at_tool") += ".mcap").string();
   auto cfg = short_walk();
   cfg.scenario.name = "arms";
   const auto s = sim::write_hand_at_tool(cfg, out, {});
@@ -70,7 +67,7 @@ TEST(SimFiles, HandAtToolRecordsTheToolWhereTheHandIs) {
 }
 
 TEST(SimBoards, ViewsEverySensorSeesWithTheirTruth) {
-  const auto dir = fresh_dir("sim_boards");
+  const auto dir = test::fresh_path("sim_boards");
   const auto cfg = short_walk();
   calib::SimBoardsOptions o;
   o.dir = dir.string();
@@ -97,7 +94,7 @@ TEST(SimBoards, ViewsEverySensorSeesWithTheirTruth) {
 }
 
 TEST(SimBoards, TheBoardOnARobotsToolAndARobotOutOfReach) {
-  const auto dir = fresh_dir("sim_robot_boards");
+  const auto dir = test::fresh_path("sim_robot_boards");
   const auto cfg = short_walk();
   calib::RobotBoardsOptions o;
   o.boards.dir = dir.string();

@@ -19,14 +19,6 @@ namespace skelgraph::cli {
 
 namespace {
 
-using eval::csv_header;
-using eval::csv_rows;
-using eval::has_at_use;
-using eval::report_section;
-using eval::write_report_page;
-using eval::write_text_file;
-
-
 struct FileOptions : eval::RecordingOptions {
   std::string file, out, report_dir, csv;
   bool json = false;
@@ -59,12 +51,12 @@ int eval_file(const FileOptions& o) {
   if (!o.report_dir.empty()) {
     std::filesystem::create_directories(o.report_dir);
     const auto name = std::filesystem::path(o.file).stem().string();
-    report_path = write_report_page(o.report_dir, "skelgraph: " + name,
-                                    report_section(o.report_dir, name, name, r, "right_hand"));
+    report_path = eval::write_report_page(o.report_dir, "skelgraph: " + name,
+                                    eval::report_section(o.report_dir, name, name, r, "right_hand"));
   }
   nlohmann::json j = scored.summary;
   if (!report_path.empty()) j["report"] = report_path;
-  if (!o.csv.empty()) write_text_file(o.csv, csv_header() + csv_rows(o.file, r));
+  if (!o.csv.empty()) eval::write_text_file(o.csv, eval::csv_header() + eval::csv_rows(o.file, r));
   if (o.json) {
     std::printf("%s\n", j.dump(2).c_str());
   } else {
@@ -150,7 +142,7 @@ RecordingReport eval_recording_section(const std::string& file, const std::strin
   o.file = file;
   const auto scored = user_input([&] { return eval::score_recording(o.file, o, true); });
   std::filesystem::create_directories(report_dir);
-  return {scored.summary, report_section(report_dir, "live", title, scored.result, "right_hand")};
+  return {scored.summary, eval::report_section(report_dir, "live", title, scored.result, "right_hand")};
 }
 
 namespace {

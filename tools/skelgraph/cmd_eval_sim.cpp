@@ -21,18 +21,11 @@ namespace skelgraph::cli {
 
 namespace {
 
-using eval::csv_header;
-using eval::csv_rows;
-using eval::has_at_use;
-using eval::report_section;
-using eval::write_report_page;
-using eval::write_text_file;
-
 }  // namespace
 
 // The printed table of every stream (Markdown).
 void print_table(const std::string& title, const eval::OfflineResult& r) {
-  const bool at_use = has_at_use(r);
+  const bool at_use = eval::has_at_use(r);
   std::printf("\n### %s\n\n| stream |", title.c_str());
   for (const auto* g : eval::group_names()) std::printf(" %s det %% | %s err cm |", g, g);
   std::printf(" mean err cm |%s offsets removed cm | upper body %% | bone SD cm |\n|---|", at_use ? " at use cm |" : "");
@@ -58,7 +51,7 @@ int eval_sim(const SimEvalOptions& o) {
   std::string html;
   if (eo.trace) std::filesystem::create_directories(o.report_dir);
   nlohmann::json out = nlohmann::json::array();
-  std::string csv = csv_header();
+  std::string csv = eval::csv_header();
   if (!o.json && !o.quiet) {
     std::printf("## Fusion against ground truth (simulator)\n\nDetection: %% of output ticks (30 Hz) a joint is reported "
                 "with confidence 1; error: mean distance to truth over those, cm. Singles: each sensor alone, on the same "
@@ -126,14 +119,14 @@ int eval_sim(const SimEvalOptions& o) {
         std::printf("\n");
       }
     }
-    if (eo.trace) html += report_section(o.report_dir, prefix + scenario, title, r, "right_hand");
-    csv += csv_rows(prefix + scenario, r);
+    if (eo.trace) html += eval::report_section(o.report_dir, prefix + scenario, title, r, "right_hand");
+    csv += eval::csv_rows(prefix + scenario, r);
   }
   }
-  if (!o.csv.empty()) write_text_file(o.csv, csv);
-  if (eo.trace) write_text_file(std::filesystem::path(o.report_dir) / "results.csv", csv);
+  if (!o.csv.empty()) eval::write_text_file(o.csv, csv);
+  if (eo.trace) eval::write_text_file(std::filesystem::path(o.report_dir) / "results.csv", csv);
   if (eo.trace) {
-    const auto path = write_report_page(o.report_dir, "skelgraph: fusion against ground truth",
+    const auto path = eval::write_report_page(o.report_dir, "skelgraph: fusion against ground truth",
                                         o.extra_html + html);
     if (!o.json && !o.quiet) std::printf("\nreport: %s\n", path.c_str());
   }
