@@ -184,8 +184,8 @@ std::optional<depth::DepthImage> OniSource::next(std::chrono::milliseconds timeo
   int ready = -1;
   const auto rc = openni::OpenNI::waitForAnyStream(streams, 1, &ready, static_cast<int>(timeout.count()));
   if (rc != openni::STATUS_OK) {
+    waited_ms_ += timeout.count();
     if (file && frames_this_pass_ == 0) {
-      waited_ms_ += timeout.count();
       if (waited_ms_ >= 2000) {
         throw std::runtime_error("openni2: no frame came from '" + opt_.uri + "' in " + std::to_string(waited_ms_) +
                                  " ms although it holds " + std::to_string(frame_count_) +
@@ -193,8 +193,16 @@ std::optional<depth::DepthImage> OniSource::next(std::chrono::milliseconds timeo
                                  "property, as the Dummy device records; mend the file with `skelgraph oni mend`)");
       }
     }
-    // A recording without an index ends when no frame comes.
+    // A recording without an index ends when no frame comes; one whose
+    // player stopped short of its index, after 2 s without a frame (the next
+    // call ends the pass, or starts another with repeat).
     if (file && frame_count_ < 0 && frames_this_pass_ > 0) at_end_ = !opt_.repeat;
+    if (file && frame_count_ >= 0 && frames_this_pass_ > 0 && waited_ms_ >= 2000 &&
+        frames_this_pass_ < static_cast<std::uint64_t>(frame_count_)) {
+      never_delivered_ += static_cast<std::uint64_t>(frame_count_) - frames_this_pass_;
+      frames_this_pass_ = static_cast<std::uint64_t>(frame_count_);
+      waited_ms_ = 0;
+    }
     return std::nullopt;
   }
   waited_ms_ = 0;

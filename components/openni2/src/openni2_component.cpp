@@ -4,6 +4,8 @@
 #include <sstream>
 #include <utility>
 
+#include <spdlog/spdlog.h>
+
 #include "skelgraph/depth/depth_msg.hpp"
 
 namespace skelgraph::openni2 {
@@ -146,7 +148,14 @@ void OpenNI2Component::run() {
         if (player_) player_->delivered(stepped);
       } else if (source_->at_end()) {
         finished_ = true;
-        ctx_.set_health(runtime::HealthState::Ok, "end of recording");
+        if (const auto lost = source_->frames_never_delivered()) {
+          ctx_.set_health(runtime::HealthState::Degraded, "end of recording: OpenNI2's player never delivered " +
+                                                              std::to_string(lost) + " of its " +
+                                                              std::to_string(source_->frame_count()) + " frames");
+          spdlog::warn("{}: OpenNI2's player never delivered {} frame(s) of the recording", ctx_.name(), lost);
+        } else {
+          ctx_.set_health(runtime::HealthState::Ok, "end of recording");
+        }
         if (player_) player_->at_end();
         break;
       }
@@ -190,6 +199,7 @@ nlohmann::json OpenNI2Component::details() const {
           {"intrinsics_from_device", source_->intrinsics_from_device()},
           {"frames_in_recording", source_->frame_count()},
           {"published", published_},
+          {"frames_never_delivered", source_->frames_never_delivered()},
           {"paused", player_ ? player_->with_gate([](runtime::PlayGate& g) { return g.paused(); }) : false},
           {"speed", player_ ? player_->with_gate([](runtime::PlayGate& g) { return g.speed(); }) : 0.0},
           {"recordings", files_},
