@@ -46,7 +46,6 @@ ok "the page's Play, speed, Pause, timeline and Step drove the player"
 # The same from the command line; nonsense refused.
 "$SKELGRAPH" player seek 2.5 >/dev/null || fail "player seek"
 "$SKELGRAPH" player pause >/dev/null || fail "player pause"
-sleep 0.3
 # The seek is answered once the player is there: the answer itself, and any state after it, carry the position.
 "$SKELGRAPH" player seek 2.5 --json >"$WORK/seek.json" || fail "player seek --json"
 json_check "$WORK/seek.json" 'd[0]["paused"] and abs(d[0]["position_s"] - 2.5) < 0.05 and not d[0]["at_end"]'
