@@ -43,6 +43,16 @@ wait_for_count() {
   done
 }
 
+# wait_until SECONDS CMD...: runs CMD (quiet) until it succeeds, polling, at most SECONDS.
+wait_until() {
+  local deadline=$((SECONDS + $1)); shift
+  while :; do
+    "$@" >/dev/null 2>&1 && return 0
+    [ "$SECONDS" -lt "$deadline" ] || return 1
+    python3 -c 'import time; time.sleep(0.2)'
+  done
+}
+
 # retry N CMD...: runs CMD until it succeeds, at most N times (each try is itself bounded).
 retry() {
   local n=$1; shift

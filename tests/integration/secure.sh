@@ -108,7 +108,10 @@ retry 3 sg fusion robot stop --timeout 10 --json >"$WORK/control.robot" || fail 
 json_check "$WORK/control.robot" 'd["taken"] and d["source"] == "operator"'
 ok "robot: a stranger and the read-only host cannot stop it; the robot-control host can"
 retry 3 sg fusion sync stop --timeout 10 --json >"$WORK/stop.json" || fail "sync stop"
-sleep 1
+# Every recorder closes its file(s) after the STOP (and its linger): complete files from each host.
+closed() { ls "$WORK"/{fusion,sensor1,sensor2}/recordings/secure_*.mcap &&
+  "$SKELGRAPH" bag info "$WORK"/{fusion,sensor1,sensor2}/recordings/secure_*.mcap; }
+wait_until 15 closed || fail "no complete recording of the session on every host: $(ls -R "$WORK"/*/recordings)"
 # Every recorder recorded the master's session only: no session of the strangers'.
 ls "$WORK"/{fusion,sensor1,sensor2}/recordings/ >"$WORK/files.txt"
 grep -q "^secure_" "$WORK/files.txt" || fail "no secure session recorded: $(cat "$WORK/files.txt")"
