@@ -19,16 +19,17 @@ cat >"$WORK/cyclone.xml" <<'XML'
 XML
 export CYCLONEDDS_URI="file://$WORK/cyclone.xml"
 
-# graph PROFILE: a simulated cell and a sync master, 7 s.
+# graph PROFILE: a simulated cell and a sync master, 7 s; returns once both have started.
 graph() {
   "$SKELGRAPH" run sim --name cell --profile "$1" --duration 7 >/dev/null 2>"$WORK/sim_$1.err" &
   "$SKELGRAPH" launch "$SRC/bringup/sync.yaml" --profile "$1" --duration 7 >/dev/null 2>"$WORK/sync_$1.err" &
+  wait_for_match "$WORK/sim_$1.err" "^\[start\] cell" 10 || fail "the simulator did not start: $(cat "$WORK/sim_$1.err")"
+  wait_for_match "$WORK/sync_$1.err" "^\[start\]" 10 || fail "the sync master did not start: $(cat "$WORK/sync_$1.err")"
 }
 
-# 1. Fast DDS -> Cyclone.
+# 1. Fast DDS -> Cyclone: the peer reads for 5 s from the graph's start.
 graph loopback-interop
-sleep 1
-"$PEER" sub 4 >"$WORK/sub.json" 2>"$WORK/sub.err" || fail "cyclone sub: $(cat "$WORK/sub.err")"
+"$PEER" sub 5 >"$WORK/sub.json" 2>"$WORK/sub.err" || fail "cyclone sub: $(cat "$WORK/sub.err")"
 # Raw skeletons are in the sensor's frame and the sensors are 1.2 m above the
 # floor: a decoded head lies between -1.2 m (the floor) and 1.5 m. (0.3 was too
 # tight: a clean-clone run decoded a first head at 0.17 m.)
@@ -40,7 +41,7 @@ wait
 "$SKELGRAPH" bag record --dir "$WORK/rec" --host fast --profile loopback-interop --duration 8 --json \
   >"$WORK/rec.json" 2>"$WORK/rec.err" &
 rec=$!
-sleep 1
+wait_for_match "$WORK/rec.err" "^\[start\] recorder" 10 || fail "the recorder did not start: $(cat "$WORK/rec.err")"
 "$PEER" sync cyclone_session 4242 >"$WORK/sync.json" 2>"$WORK/sync.err" || fail "cyclone sync: $(cat "$WORK/sync.err")"
 wait "$rec" || fail "recorder: $(tail -3 "$WORK/rec.err")"
 [ -f "$WORK/rec/cyclone_session_4242_fast.mcap" ] || fail "no recording of the Cyclone session: $(ls "$WORK/rec")"
@@ -50,7 +51,6 @@ ok "a Cyclone sync master's START/30 TICKs/STOP: our recorder wrote the session 
 
 # 3. Pinned: the plain loopback profile announces TypeInformation, which Cyclone 0.10 rejects.
 graph loopback
-sleep 1
 "$PEER" sub 4 >"$WORK/sub0.json" 2>"$WORK/sub0.err" || fail "cyclone sub: $(cat "$WORK/sub0.err")"
 json_check "$WORK/sub0.json" 'd["skeletons"] == 0 and d["sync"]["tick"] == 0'
 grep -q "TYPE_INFORMATION) invalid" "$WORK/sub0.err" ||
