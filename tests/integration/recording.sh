@@ -72,7 +72,8 @@ kill -INT "$sim"; wait "$sim" || true
 rec=$!
 wait_for_match "$WORK/r.err" "recording session" 20 || fail "re-recorder did not start: $(cat "$WORK/r.err")"
 timeout 60 "$SKELGRAPH" bag play "$a_file" --json >"$WORK/play.json" 2>"$WORK/play.err" || fail "play (ends by itself at the end of the file): $(cat "$WORK/play.err")"
-sleep 1  # the recorder writes what its readers acknowledged
+# The player ended once its reliable readers acknowledged everything; the
+# recorder takes what its readers hold before it closes the file on SIGINT.
 kill -INT "$rec"; wait "$rec" || fail "re-record: $(cat "$WORK/r.err")"
 "$SKELGRAPH" bag info "$a_file" --json >"$WORK/orig.json"
 "$SKELGRAPH" bag info "$WORK/replay"/replay_*.mcap --json >"$WORK/again.json"
