@@ -10,6 +10,8 @@ out=${2:-/tmp/skelgraph-loaded}
 src=$(cd "$(dirname "$0")/.." && pwd)
 mkdir -p "$out"
 clone="$out/clone"
+# The tests read the shared data sets beside the repository (../shared/data).
+if [ -d "$src/../shared" ] && [ ! -e "$out/shared" ]; then ln -s "$(cd "$src/../shared" && pwd)" "$out/shared"; fi
 rm -rf "$clone" && git clone -q "$src" "$clone" && cd "$clone" || exit 1
 echo "commit $(git rev-parse --short HEAD)"
 start=$(date +%s)

@@ -39,32 +39,31 @@ sys.exit(1)' "$1" >"$WORK/status_$1.json" && return 0
   done
   return 1
 }
-# keeps_up NAME SENSORS: between two of fusion's status reports about 3 s apart
-# (its own counts: no reader of ours in between to lose samples on a busy
-# machine), one fused skeleton per step of the SENSORS live sensors: fused out
-# over raw in per sensor, 0.8-1.25. Prints "fused/frames".
+# keeps_up NAME SENSORS: between two of fusion's status reports at least 3 s
+# apart by their stamps (its own counts: no reader of ours in between to lose
+# samples on a busy machine), one fused skeleton per step of the SENSORS live
+# sensors: fused out over raw in per sensor, 0.8-1.25. Prints "fused/frames".
 keeps_up() {
-  local i
-  for i in 1 2; do
-    { timeout 8 "$SKELGRAPH" topic echo skelgraph/status --json --timeout 5 2>/dev/null || true; } | python3 -c '
+  { timeout 15 "$SKELGRAPH" topic echo skelgraph/status --json --timeout 10 2>/dev/null || true; } |
+    python3 -c '
 import json, sys
+sensors, first = int(sys.argv[1]), None
+count = lambda d, topic, out: next(t["count"] for t in d["topics"] if t["topic"] == topic and t["is_output"] == out)
 for line in sys.stdin:
     d = json.loads(line)["data"]
-    if d["component_name"] == "fusion":
-        print(json.dumps(d)); sys.exit(0)
-sys.exit(1)' >"$WORK/keeps_up_$1_$i.json" || return 1
-    [ "$i" = 1 ] && sleep 3
-  done
-  python3 - "$WORK/keeps_up_$1_1.json" "$WORK/keeps_up_$1_2.json" "$2" <<'PY'
-import json, sys
-a, b = (json.load(open(p)) for p in sys.argv[1:3])
-sensors = int(sys.argv[3])
-count = lambda d, topic, out: next(t["count"] for t in d["topics"] if t["topic"] == topic and t["is_output"] == out)
-fused = count(b, "skelgraph/skeleton/fused", True) - count(a, "skelgraph/skeleton/fused", True)
-frames = (count(b, "skelgraph/skeleton/raw", False) - count(a, "skelgraph/skeleton/raw", False)) / sensors
-print(f"{fused}/{frames:.0f}")
-sys.exit(0 if frames >= 30 and 0.8 <= fused / frames <= 1.25 else 1)
-PY
+    if d["component_name"] != "fusion":
+        continue
+    if first is None:
+        first = d
+        continue
+    if d["stamp_ns"] - first["stamp_ns"] < 3e9:
+        continue
+    fused = count(d, "skelgraph/skeleton/fused", True) - count(first, "skelgraph/skeleton/fused", True)
+    frames = (count(d, "skelgraph/skeleton/raw", False) - count(first, "skelgraph/skeleton/raw", False)) / sensors
+    print(f"{fused}/{frames:.0f}")
+    sys.exit(0 if frames >= 30 and 0.8 <= fused / frames <= 1.25 else 1)
+print("no two fusion status reports 3 s apart")
+sys.exit(1)' "$2"
 }
 
 status OK || fail "fusion never OK: $(tail -5 "$WORK/fusion.err")"
