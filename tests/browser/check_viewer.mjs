@@ -34,7 +34,8 @@ try {
   const a = await stats();
   const t0 = Date.now();
   const snapshots = [];
-  while (Date.now() - t0 < seconds * 1000) {
+  // SECONDS, and at least 12 snapshots however slowly a busy machine answers (at most 30 s).
+  while (Date.now() - t0 < seconds * 1000 || (snapshots.length < 12 && Date.now() - t0 < 30000)) {
     await sleep(250);
     snapshots.push((await stats()).drawn);
   }

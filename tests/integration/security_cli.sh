@@ -22,7 +22,7 @@ sim=$!
 # A new secure participant sometimes fails to authenticate and the next try works (docs/security.md).
 SKELGRAPH_HOST=fusion retry 3 "$SKELGRAPH" topic hz skelgraph/skeleton/raw --security "$WORK/creds" --window 2 --timeout 8 \
   --json >"$WORK/hz.json" 2>"$WORK/hz.err" || fail "the master host read nothing: $(cat "$WORK/hz.err")"
-json_check "$WORK/hz.json" '50 < d["rate_hz"] < 70'
+json_check "$WORK/hz.json" 'd["samples"] >= 20'
 if "$SKELGRAPH" topic echo skelgraph/skeleton/raw --count 1 --timeout 4 >"$WORK/plain.out" 2>&1; then
   fail "a participant without credentials read skeletons"
 fi
