@@ -784,3 +784,67 @@ TEST(RobotCalib, AHandAtTheToolGivesARoughPoseAndLeavesOutAHandElsewhere) {
   holds.resize(3);
   EXPECT_NE(error_of([&] { calib::fit_hand_at_tool(holds); }).find("need 4 or more"), std::string::npos);
 }
+
+TEST(RobotCalib, AHandAtTheToolCalibratesEachSensorOrTheWholeCell) {
+  // The tool (robot's world) stops at 8 places for 1.5 s each; two sensors see
+  // the hand at it, 2 cm off. The robot's base stands away from the world's origin.
+  const Eigen::Isometry3d world_from_base = iso(rot(0, 30, 0), Vector3d(0.5, 0, -0.2));
+  const std::map<std::string, Eigen::Isometry3d> world_from{{"s1", iso(rot(-60, 5, 0), Vector3d(-1.5, 0.8, 0.9))},
+                                                            {"s2", iso(rot(50, -5, 0), Vector3d(1.4, 0.9, 1.1))}};
+  std::vector<Vector3d> stops;
+  for (const auto& p : cloud(8, 11)) stops.push_back(0.4 * p + Vector3d(0.3, 0.6, 0.3));
+  std::vector<calib::TimedPoint> tool;
+  std::map<std::string, std::map<std::pair<std::uint32_t, int>, std::vector<calib::TimedPoint>>> hands;
+  std::int64_t t = 0;
+  const std::int64_t dt = 33'333'333;
+  for (std::size_t s = 0; s < stops.size(); ++s) {
+    const Vector3d from = s == 0 ? Vector3d(0, 0, 0) : stops[s - 1];
+    const int travel = 30;
+    for (int i = 0; i <= travel + 45; ++i, t += dt) {
+      const Vector3d p = i < travel ? Vector3d(from + (stops[s] - from) * (double(i) / travel)) : stops[s];
+      tool.push_back({t, p});
+      for (const auto& [sensor, pose] : world_from) {
+        hands[sensor][{1, 0}].push_back({t, pose.inverse() * (p + Vector3d(0.02, 0, 0))});
+      }
+    }
+  }
+  hands["s3"][{1, 0}] = hands["s1"][{1, 0}];  // a third sensor the cell file does not know
+
+  calib::HandCalibOptions o;
+  o.world_from_base = world_from_base;
+  const auto each = calib::calibrate_hand_at_tool(tool, hands, o);
+  ASSERT_EQ(each.fits.size(), 3u);
+  EXPECT_TRUE(each.failed.empty());
+  for (const auto& f : each.fits) {
+    const auto& truth = world_from.at(f.sensor == "s3" ? "s1" : f.sensor);
+    const Eigen::Isometry3d world_from_sensor = world_from_base * f.fit.base_from_sensor;
+    EXPECT_EQ(f.holds, 8u) << f.sensor;
+    EXPECT_EQ(f.places, 8u) << f.sensor;
+    EXPECT_EQ(f.places_agreeing, 8u) << f.sensor;
+    EXPECT_LT((world_from_sensor.translation() - truth.translation()).norm(), 0.05) << f.sensor;
+    EXPECT_LT(calib::rotation_angle_deg(world_from_sensor.linear() * truth.linear().transpose()), 3.0) << f.sensor;
+    EXPECT_TRUE(calib::hand_fit_good(f)) << f.sensor;
+  }
+
+  o.cell = world_from;  // the sensors already calibrated to each other
+  o.cell_name = "cell.yaml";
+  const auto cell = calib::calibrate_hand_at_tool(tool, hands, o);
+  ASSERT_EQ(cell.failed.size(), 1u);
+  EXPECT_EQ(cell.failed[0], "s3: not in cell.yaml");
+  ASSERT_EQ(cell.fits.size(), 2u);
+  for (const auto& f : cell.fits) {
+    EXPECT_EQ(f.holds, 16u) << f.sensor;  // both sensors' holds pooled
+    EXPECT_EQ(f.places, 8u) << f.sensor;
+    const Eigen::Isometry3d world_from_sensor = world_from_base * f.fit.base_from_sensor;
+    EXPECT_LT((world_from_sensor.translation() - world_from.at(f.sensor).translation()).norm(), 0.05) << f.sensor;
+  }
+
+  auto poor = each.fits[0];
+  poor.places_agreeing = 6;  // a hand agreeing at 6 of 8 places is under 80 %
+  EXPECT_FALSE(calib::hand_fit_good(poor));
+  std::vector<calib::Hold> three(3);  // two hands at one place, 3 cm apart, and one 30 cm away
+  three[1].tool = Vector3d(0.03, 0, 0);
+  three[2].tool = Vector3d(0.3, 0, 0);
+  EXPECT_EQ(calib::count_places(three, {0, 1, 2}, 0.05), 2u);
+  EXPECT_EQ(calib::count_places(three, {0, 1}, 0.05), 1u);
+}

@@ -4,34 +4,23 @@
 // skeletons).
 
 #include <algorithm>
-#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <map>
-#include <optional>
 
 #include <nlohmann/json.hpp>
 
 #include "cmd_calib.hpp"
 #include "skelgraph/calib/board.hpp"
-#include "skelgraph/skeleton/json_number.hpp"
-#include "skelgraph/skeleton/stats.hpp"
 #include "skelgraph/calib/calib_file.hpp"
-#include "skelgraph/calib/calibration_step.hpp"
 #include "skelgraph/calib/inputs.hpp"
 #include "skelgraph/calib/sim_check.hpp"
-#include "skelgraph/calib/skeleton_calib.hpp"
-#include "skelgraph/eval/metrics.hpp"
-#include "skelgraph/playback/readers.hpp"
 #include "skelgraph/robot/robot_component.hpp"
-#include "skelgraph/runtime/topics.hpp"
-#include "skelgraph/sim/simulation.hpp"
-#include "skelgraph/skeleton/skeleton_msg.hpp"
+#include "skelgraph/skeleton/skeleton.hpp"
 
 namespace skelgraph::cli::calib_cmd {
 
 namespace {
-
 
 // The hand at the tool (calib/inputs.hpp); a bad recording is a usage error.
 calib::HandInput read_hand_input(const std::string& path, const std::vector<skeleton::JointId>& joints) {
@@ -67,10 +56,10 @@ int calib_robot(const RobotOptions& o) {
     std::vector<std::string> skipped;
     std::size_t offered = 0;  // views (board) or holds (hand)
     std::size_t places = 0, places_agreeing = 0;  // hand: where the tool held still, and where a hand agreed
+    bool good = false;        // calib::board_fit_good / hand_fit_good
   };
   std::vector<Result> results;
   std::vector<std::string> failed;  // sensors without a fit, with the reason
-  std::vector<std::string> cell_sensors;  // --cell: the sensors fitted together
   if (hand_mode) {
     // Either hand by default: a tracker that sees the person's back swaps left and right,
     // and the hand not at the tool is an outlier RANSAC leaves out.
@@ -78,72 +67,19 @@ int calib_robot(const RobotOptions& o) {
     if (o.hand != "left") joints.push_back(skeleton::JointId::RightHand);
     if (o.hand != "right") joints.push_back(skeleton::JointId::LeftHand);
     const auto in = read_hand_input(o.hand_recording, joints);
-    calib::HoldOptions ho;
-    ho.hold_s = o.hold_s;
-    // --cell: the sensors already calibrated to each other; every sensor's
-    // holds in that frame, one fit for the whole cell (the sensors' hand
-    // errors differ by view and partly cancel).
-    std::map<std::string, Eigen::Isometry3d> cell;
-    if (!o.cell.empty()) cell = prior_poses(o.cell);
-    std::map<std::string, std::vector<calib::Hold>> by_sensor;
-    for (const auto& [sensor, people] : in.hands) {
-      auto& holds = by_sensor[sensor];
-      for (const auto& [id, pts] : people) {
-        const auto h = calib::find_holds(in.tool, pts, ho);
-        holds.insert(holds.end(), h.begin(), h.end());
-      }
-      // The tool's positions are in the world the robot reports in: to its base.
-      for (auto& h : holds) h.tool = world_from_base.inverse() * h.tool;
+    calib::HandCalibOptions ho;
+    ho.holds.hold_s = o.hold_s;
+    ho.inlier_m = o.inlier_cm / 100.0;
+    ho.world_from_base = world_from_base;
+    if (!o.cell.empty()) {
+      ho.cell = prior_poses(o.cell);
+      ho.cell_name = o.cell;
     }
-    if (!cell.empty()) {
-      std::vector<calib::Hold> pooled;
-      std::vector<std::string> in_cell;
-      for (auto& [sensor, holds] : by_sensor) {
-        const auto c = cell.find(sensor);
-        if (c == cell.end()) {
-          failed.push_back(sensor + ": not in " + o.cell);
-          continue;
-        }
-        for (auto h : holds) {
-          h.hand = c->second * h.hand;
-          pooled.push_back(h);
-        }
-        in_cell.push_back(sensor);
-      }
-      by_sensor.clear();
-      by_sensor["cell"] = pooled;
-      cell_sensors = in_cell;
-    }
-    for (const auto& [sensor, holds] : by_sensor) {
-      // The places the tool held still at (both hands may pair with one).
-      const auto places = [&](const std::vector<std::size_t>& which) {
-        std::vector<Eigen::Vector3d> out;
-        for (std::size_t i : which) {
-          if (std::none_of(out.begin(), out.end(), [&](const Eigen::Vector3d& p) { return (p - holds[i].tool).norm() < ho.min_gap_m; })) {
-            out.push_back(holds[i].tool);
-          }
-        }
-        return out.size();
-      };
-      try {
-        Result r{sensor, calib::fit_hand_at_tool(holds, o.inlier_cm / 100.0), {}, holds.size()};
-        std::vector<std::size_t> all(holds.size());
-        for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
-        r.places = places(all);
-        r.places_agreeing = places(r.fit.ransac.inliers);
-        if (sensor == "cell" && !cell.empty()) {  // base_from_cell: each sensor through its pose in the cell
-          for (const auto& s : cell_sensors) {
-            Result rs = r;
-            rs.sensor = s;
-            rs.fit.base_from_sensor = r.fit.base_from_sensor * cell.at(s);
-            results.push_back(std::move(rs));
-          }
-        } else {
-          results.push_back(std::move(r));
-        }
-      } catch (const calib::CalibError& e) {
-        failed.push_back(sensor + ": " + e.what());
-      }
+    auto hc = calib::calibrate_hand_at_tool(in.tool, in.hands, ho);
+    failed = std::move(hc.failed);
+    for (auto& f : hc.fits) {
+      const bool good = calib::hand_fit_good(f);
+      results.push_back({f.sensor, std::move(f.fit), {}, f.holds, f.places, f.places_agreeing, good});
     }
   } else {
     calib::ToolPoses poses;
@@ -181,16 +117,15 @@ int calib_robot(const RobotOptions& o) {
         progress(sensor + ": " + std::to_string(i + 1) + " of " + std::to_string(names.size()) + " views read", i + 1 == names.size());
       }
       try {
-        results.push_back({sensor, calib::fit_board_on_tool(corners, base_from_board, board.object_points()), skipped, names.size()});
+        auto fit = calib::fit_board_on_tool(corners, base_from_board, board.object_points());
+        const bool good = calib::board_fit_good(fit);
+        results.push_back({sensor, std::move(fit), skipped, names.size(), 0, 0, good});
       } catch (const calib::CalibError& e) {
         failed.push_back(sensor + ": " + e.what() + (skipped.empty() ? "" : " (" + skipped.front() + ")"));
       }
     }
   }
 
-  // Verdicts: the board's corners agree within 1 cm RMS with few outliers; a
-  // hand (a joint a few cm from the touch, and a tracker's noise) within 4 cm.
-  const double good_rms_m = hand_mode ? 0.04 : 0.01;
   nlohmann::json sensors = nlohmann::json::array();
   calib::CalibFile file;
   file.comment = std::string("written by skelgraph calib robot ") +
@@ -198,8 +133,7 @@ int calib_robot(const RobotOptions& o) {
   bool all_good = failed.empty() && !results.empty();
   for (const auto& r : results) {
     const auto& f = r.fit.ransac.fit;
-    const bool good = f.rms < good_rms_m && (hand_mode ? r.places_agreeing * 10 >= r.places * 8
-                                                       : r.fit.ransac.inliers.size() * 10 >= r.fit.points * 8);
+    const bool good = r.good;
     all_good = all_good && good;
     const Eigen::Isometry3d world_from_sensor = world_from_base * r.fit.base_from_sensor;
     nlohmann::json j{{"sensor", r.sensor}, {hand_mode ? "holds" : "views", r.offered}, {"used", r.fit.views},

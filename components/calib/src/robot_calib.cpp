@@ -131,4 +131,79 @@ RobotFit fit_hand_at_tool(const std::vector<Hold>& holds, double inlier_m) {
   return out;
 }
 
+std::size_t count_places(const std::vector<Hold>& holds, const std::vector<std::size_t>& which, double min_gap_m) {
+  std::vector<Vector3d> places;
+  for (std::size_t i : which) {
+    if (std::none_of(places.begin(), places.end(), [&](const Vector3d& p) { return (p - holds[i].tool).norm() < min_gap_m; })) {
+      places.push_back(holds[i].tool);
+    }
+  }
+  return places.size();
+}
+
+HandCalibration calibrate_hand_at_tool(
+    const std::vector<TimedPoint>& tool,
+    const std::map<std::string, std::map<std::pair<std::uint32_t, int>, std::vector<TimedPoint>>>& hands,
+    const HandCalibOptions& o) {
+  HandCalibration out;
+  const Eigen::Isometry3d base_from_world = o.world_from_base.inverse();
+  std::map<std::string, std::vector<Hold>> by_sensor;
+  for (const auto& [sensor, people] : hands) {
+    auto& holds = by_sensor[sensor];
+    for (const auto& [id, pts] : people) {
+      const auto h = find_holds(tool, pts, o.holds);
+      holds.insert(holds.end(), h.begin(), h.end());
+    }
+    for (auto& h : holds) h.tool = base_from_world * h.tool;
+  }
+  std::vector<std::string> in_cell;
+  if (!o.cell.empty()) {
+    std::vector<Hold> pooled;
+    for (const auto& [sensor, holds] : by_sensor) {
+      const auto c = o.cell.find(sensor);
+      if (c == o.cell.end()) {
+        out.failed.push_back(sensor + ": not in " + o.cell_name);
+        continue;
+      }
+      for (auto h : holds) {
+        h.hand = c->second * h.hand;
+        pooled.push_back(h);
+      }
+      in_cell.push_back(sensor);
+    }
+    by_sensor.clear();
+    by_sensor["cell"] = std::move(pooled);
+  }
+  for (const auto& [sensor, holds] : by_sensor) {
+    try {
+      HandFit r{sensor, fit_hand_at_tool(holds, o.inlier_m), holds.size()};
+      std::vector<std::size_t> all(holds.size());
+      for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
+      r.places = count_places(holds, all, o.holds.min_gap_m);
+      r.places_agreeing = count_places(holds, r.fit.ransac.inliers, o.holds.min_gap_m);
+      if (o.cell.empty()) {
+        out.fits.push_back(std::move(r));
+        continue;
+      }
+      for (const auto& s : in_cell) {  // base_from_cell, then each sensor through its pose in the cell
+        HandFit rs = r;
+        rs.sensor = s;
+        rs.fit.base_from_sensor = r.fit.base_from_sensor * o.cell.at(s);
+        out.fits.push_back(std::move(rs));
+      }
+    } catch (const CalibError& e) {
+      out.failed.push_back(sensor + ": " + e.what());
+    }
+  }
+  return out;
+}
+
+bool board_fit_good(const RobotFit& fit) {
+  return fit.ransac.fit.rms < 0.01 && fit.ransac.inliers.size() * 10 >= fit.points * 8;
+}
+
+bool hand_fit_good(const HandFit& fit) {
+  return fit.fit.ransac.fit.rms < 0.04 && fit.places_agreeing * 10 >= fit.places * 8;
+}
+
 }  // namespace skelgraph::calib

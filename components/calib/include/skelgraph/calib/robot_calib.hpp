@@ -81,4 +81,50 @@ std::vector<Hold> find_holds(const std::vector<TimedPoint>& tool, const std::vec
 // than 4 holds or holds on a line.
 RobotFit fit_hand_at_tool(const std::vector<Hold>& holds, double inlier_m = 0.08);
 
+// How many places the tool held still at, over the holds `which` (holds
+// closer than min_gap_m are one place; both hands may pair with one).
+std::size_t count_places(const std::vector<Hold>& holds, const std::vector<std::size_t>& which, double min_gap_m);
+
+// One sensor's pose from a hand at the tool, and how well it is backed.
+struct HandFit {
+  std::string sensor;
+  RobotFit fit;
+  std::size_t holds = 0;            // holds offered
+  std::size_t places = 0;           // places the tool held still at
+  std::size_t places_agreeing = 0;  // of them, where a hand agreed (RANSAC inliers)
+};
+
+struct HandCalibration {
+  std::vector<HandFit> fits;
+  std::vector<std::string> failed;  // "sensor: why", for sensors without a fit
+};
+
+struct HandCalibOptions {
+  HoldOptions holds;
+  double inlier_m = 0.08;
+  Eigen::Isometry3d world_from_base = Eigen::Isometry3d::Identity();  // where the robot's base stands
+  // The sensors already calibrated to each other (world_from_sensor): every
+  // sensor's holds are pooled in that frame and fitted once for the whole
+  // cell (the sensors' hand errors differ by view and partly cancel), each
+  // sensor then placed through its pose in the cell. Empty: one fit per sensor.
+  std::map<std::string, Eigen::Isometry3d> cell;
+  std::string cell_name = "the cell";  // where the cell came from, for messages
+};
+
+// The hand at the tool end to end: `tool` the tool point in the robot's world
+// (time order), `hands` per sensor and (person, joint) the hand joint in the
+// sensor's frame (read_hand_input). Each person's holds (find_holds) go to the
+// robot's base, then to one fit per sensor or for the cell. A sensor that
+// cannot be fitted is named in `failed` with the reason.
+HandCalibration calibrate_hand_at_tool(
+    const std::vector<TimedPoint>& tool,
+    const std::map<std::string, std::map<std::pair<std::uint32_t, int>, std::vector<TimedPoint>>>& hands,
+    const HandCalibOptions& options = {});
+
+// Verdicts. A board's corners agree within 1 cm RMS with at most 20 %
+// outliers; a hand (a joint a few cm from the touch, and a tracker's noise)
+// within 4 cm RMS at 80 % of the places or more.
+bool board_fit_good(const RobotFit& fit);
+bool hand_fit_good(const HandFit& fit);
+
 }  // namespace skelgraph::calib
