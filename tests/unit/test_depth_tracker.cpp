@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "skelgraph/depth_tracker/frame_matcher.hpp"
+#include "skelgraph/depth_tracker/image_check.hpp"
 #include "skelgraph/depth_tracker/sim_depth.hpp"
 #include "skelgraph/depth_tracker/tracker.hpp"
 #include "skelgraph/sim/body.hpp"
@@ -296,4 +297,59 @@ TEST(FrameMatcher, TheLeadsFrameGathersEachSensorsLatestOfTheSameMoment) {
   depth_tracker::FrameMatcher<std::size_t> by_index(40'000'000, std::size_t{0});
   EXPECT_TRUE(by_index.add(1, 0, image(1)).empty());
   EXPECT_EQ(by_index.add(0, 5'000'000, image(1)).size(), 2u);
+}
+
+TEST(ImageCheck, TheNearestPersonsJointsLieOnTheImageAndAJointInTheAirDoesNot) {
+  Rig rig(sensor_at({0.0, 1.2, 3.0}, 180.0));
+  sim::Rng rng(3);
+  const auto near = person(0.0, -0.7), far = person(0.0, 0.7);
+  auto far_back = far;  // 1 m further from the sensor
+  for (auto& j : far_back.joints) j.position.z() -= 1.0;
+  const auto img = shot(rig.r, {near, far_back}, rng, 0);
+  const Eigen::Isometry3d sensor_from_world = rig.cfg.world_from_sensor().inverse();
+  std::vector<skeleton::Skeleton> tracked{far_back, near};  // the truth, as a tracker in the sensor's frame would report it
+  for (auto& s : tracked) {
+    s.person_id = &s == &tracked[0] ? 7 : 9;
+    for (auto& j : s.joints) {
+      j.position = sensor_from_world * j.position;
+      j.confidence = 1.0;
+    }
+  }
+  tracked[1].joints[static_cast<std::size_t>(JointId::RightHand)].position.z() -= 0.4;  // 40 cm in front of the body: in the air
+  tracked[1].joints[static_cast<std::size_t>(JointId::Head)].confidence = 0.0;        // not reported
+  const auto checked = depth_tracker::check_people(img, tracked);
+  ASSERT_EQ(checked.size(), 2u);
+  EXPECT_FALSE(checked[0].nearest);
+  EXPECT_EQ(checked[0].person_id, 7u);
+  ASSERT_TRUE(checked[1].nearest);
+  EXPECT_EQ(checked[1].person_id, 9u);
+  EXPECT_EQ(checked[1].joints.size(), skeleton::kJointCount - 1);
+  EXPECT_EQ(checked[1].on_person, skeleton::kJointCount - 2);
+  for (const auto& j : checked[1].joints) {
+    EXPECT_NE(j.joint, JointId::Head);
+    EXPECT_EQ(j.on_person, j.joint != JointId::RightHand) << skeleton::joint_name(j.joint);
+    EXPECT_TRUE(j.pixel.x() >= 0 && j.pixel.x() < 320 && j.pixel.y() >= 0 && j.pixel.y() < 240);
+  }
+  EXPECT_TRUE(depth_tracker::check_people(img, {}).empty());
+}
+
+TEST(ImageCheck, BoneSpreadsGatherTheUpperBodysBonesWhereBothEndsAreReported) {
+  depth_tracker::BoneSpreads spreads;
+  auto s = person(0.0);
+  for (auto& j : s.joints) j.confidence = 1.0;
+  const double forearm = (s[JointId::RightElbow].position - s[JointId::RightHand].position).norm();
+  spreads.add(s);
+  s.joints[static_cast<std::size_t>(JointId::RightElbow)].position =
+      s[JointId::RightHand].position + (s[JointId::RightElbow].position - s[JointId::RightHand].position) * (1.1);  // 10 % longer
+  s.joints[static_cast<std::size_t>(JointId::Head)].confidence = 0.0;
+  spreads.add(s);
+  const auto sum = spreads.summary();
+  ASSERT_EQ(sum.size(), 6u);
+  EXPECT_EQ(sum.at("neck-head").images, 1u);
+  EXPECT_EQ(sum.at("neck-head").sd_m, 0.0);
+  const auto& f = sum.at("right_elbow-right_hand");
+  EXPECT_EQ(f.images, 2u);
+  EXPECT_NEAR(f.mean_m, 1.05 * forearm, 1e-12);
+  EXPECT_NEAR(f.sd_m, 0.1 * forearm / std::sqrt(2.0), 1e-12);
+  EXPECT_EQ(sum.at("left_shoulder-right_shoulder").images, 2u);
 }

@@ -2,8 +2,6 @@
 // summarised (no DDS), or played on skelgraph/depth (the depth_files component).
 
 #include <algorithm>
-#include <cmath>
-#include <map>
 #include <cstdio>
 #include <memory>
 
@@ -12,6 +10,7 @@
 #include "cli.hpp"
 #include "run_graph.hpp"
 #include "skelgraph/depth/depth_files.hpp"
+#include "skelgraph/depth_tracker/image_check.hpp"
 #include "skelgraph/depth_tracker/tracker.hpp"
 
 namespace skelgraph::cli {
@@ -120,12 +119,8 @@ int track(const DepthOpts& o) {
   tracker.set_pose(level);
   BadInputs bad;
   nlohmann::json images = nlohmann::json::array();
-  std::map<std::string, std::vector<double>> bones;
+  depth_tracker::BoneSpreads bones;
   std::size_t with_one = 0, with_any = 0, joints_reported = 0, joints_on = 0;
-  const std::vector<std::pair<skeleton::JointId, skeleton::JointId>> bone_list = {
-      {skeleton::JointId::Neck, skeleton::JointId::Head},           {skeleton::JointId::LeftShoulder, skeleton::JointId::RightShoulder},
-      {skeleton::JointId::LeftShoulder, skeleton::JointId::LeftElbow}, {skeleton::JointId::LeftElbow, skeleton::JointId::LeftHand},
-      {skeleton::JointId::RightShoulder, skeleton::JointId::RightElbow}, {skeleton::JointId::RightElbow, skeleton::JointId::RightHand}};
   for (std::size_t i = 0; i < folder->size(); ++i) {
     depth::DepthImage img;
     if (!bad.guard([&] {
@@ -142,56 +137,35 @@ int track(const DepthOpts& o) {
       tracker.set_pose(level);
     }
     const auto people = tracker.track(img);
-    nlohmann::json f{{"file", folder->file(i)}, {"people", people.size()}};
     if (people.size() == 1) ++with_one;
     if (!people.empty()) ++with_any;
-    // The nearest person is the one the image is of (the others: whatever else the image holds).
-    std::size_t nearest = 0;
-    for (std::size_t k = 1; k < people.size(); ++k)
-      if (people[k][skeleton::JointId::Torso].position.z() < people[nearest][skeleton::JointId::Torso].position.z()) nearest = k;
     nlohmann::json ps = nlohmann::json::array();
-    for (std::size_t k = 0; k < people.size(); ++k) {
-      const auto& s = people[k];
+    std::size_t nearest = 0;
+    for (const auto& p : depth_tracker::check_people(img, people, o.on_person_m)) {
       nlohmann::json joints = nlohmann::json::object();
-      std::size_t on = 0, reported = 0;
-      for (std::size_t j = 0; j < skeleton::kJointCount; ++j) {
-        const auto& jt = s.joints[j];
-        if (jt.confidence <= 0) continue;
-        ++reported;
-        const auto px = depth::project(img.intrinsics, jt.position);
-        const bool on_person = depth_tracker::on_surface(img, jt.position, o.on_person_m);
-        on += on_person;
-        joints[skeleton::joint_name(skeleton::joint_at(j))] = {
-            {"pixel", {px.x(), px.y()}}, {"confidence", jt.confidence}, {"on_person", on_person}};
+      for (const auto& j : p.joints) {
+        joints[skeleton::joint_name(j.joint)] = {
+            {"pixel", {j.pixel.x(), j.pixel.y()}}, {"confidence", j.confidence}, {"on_person", j.on_person}};
       }
-      if (k != nearest) {
-        ps.push_back({{"person", s.person_id}, {"nearest", false}, {"joints_reported", reported}, {"joints_on_person", on}, {"joints", joints}});
-        continue;
+      if (p.nearest) {
+        nearest = ps.size();
+        joints_reported += p.joints.size();
+        joints_on += p.on_person;
+        bones.add(people[nearest]);
       }
-      joints_reported += reported;
-      joints_on += on;
-      for (const auto& [a, b] : bone_list) {
-        if (s[a].confidence <= 0 || s[b].confidence <= 0) continue;
-        bones[std::string(skeleton::joint_name(a)) + "-" + skeleton::joint_name(b)].push_back((s[a].position - s[b].position).norm());
-      }
-      ps.push_back({{"person", s.person_id}, {"nearest", true}, {"joints_reported", reported}, {"joints_on_person", on}, {"joints", joints}});
+      ps.push_back({{"person", p.person_id}, {"nearest", p.nearest}, {"joints_reported", p.joints.size()},
+                    {"joints_on_person", p.on_person}, {"joints", joints}});
     }
-    f["skeletons"] = ps;
     if (!o.json)
       std::printf("%s: %zu people%s\n", folder->file(i).c_str(), people.size(),
                   people.empty() ? "" : (", the nearest's joints on the person " + std::to_string(ps[nearest]["joints_on_person"].get<std::size_t>()) +
                                          " of " + std::to_string(ps[nearest]["joints_reported"].get<std::size_t>())).c_str());
-    images.push_back(std::move(f));
+    images.push_back({{"file", folder->file(i)}, {"people", people.size()}, {"skeletons", ps}});
   }
   nlohmann::json spread = nlohmann::json::object();
-  for (const auto& [name, v] : bones) {
-    double mean = 0, sq = 0;
-    for (double x : v) mean += x;
-    mean /= static_cast<double>(v.size());
-    for (double x : v) sq += (x - mean) * (x - mean);
-    const double sd = v.size() > 1 ? std::sqrt(sq / static_cast<double>(v.size() - 1)) : 0.0;
-    spread[name] = {{"images", v.size()}, {"mean_m", mean}, {"sd_m", sd}};
-    if (!o.json) std::printf("  %-28s %2zu images, mean %.3f m, sd %.3f m\n", name.c_str(), v.size(), mean, sd);
+  for (const auto& [name, b] : bones.summary()) {
+    spread[name] = {{"images", b.images}, {"mean_m", b.mean_m}, {"sd_m", b.sd_m}};
+    if (!o.json) std::printf("  %-28s %2zu images, mean %.3f m, sd %.3f m\n", name.c_str(), b.images, b.mean_m, b.sd_m);
   }
   nlohmann::json out{{"directory", o.dir},      {"images", folder->size()},        {"with_one_person", with_one},
                      {"with_a_person", with_any},
