@@ -13,6 +13,7 @@
 #include "skelgraph/playback/readers.hpp"
 #include "skelgraph/recording/info.hpp"
 #include "skelgraph/robot/arm.hpp"
+#include "skelgraph/sim/sim_component.hpp"
 #include "skelgraph/sim/sim_files.hpp"
 
 using namespace skelgraph;
@@ -116,5 +117,20 @@ TEST(SimBoards, TheBoardOnARobotsToolAndARobotOutOfReach) {
     FAIL() << "a robot out of reach was taken";
   } catch (const calib::CalibError& e) {
     EXPECT_NE(std::string(e.what()).find("sensor1: the robot at 9,0,9,0"), std::string::npos) << e.what();
+  }
+}
+
+TEST(SimParams, AssignmentsThenExtrasMakeACheckedConfiguration) {
+  const auto cfg = sim::sim_config_from_assignments({"sensor_count=3", "seed=7"}, "test", {{"scenario", "arms", "test"}});
+  EXPECT_EQ(cfg.sensors.size(), 3u);
+  EXPECT_EQ(cfg.scenario.seed, 7u);
+  EXPECT_EQ(cfg.scenario.name, "arms");
+  EXPECT_THROW(sim::sim_config_from_assignments({"sensor_count"}, "test"), runtime::ParamError);  // no '='
+  EXPECT_THROW(sim::sim_config_from_assignments({"no_such=1"}, "test"), runtime::ParamError);
+  try {
+    sim::sim_config_from_assignments({"scenario=dance"}, "sim export");
+    FAIL() << "an unknown scenario was accepted";
+  } catch (const runtime::ParamError& e) {
+    EXPECT_NE(std::string(e.what()).find("dance"), std::string::npos) << e.what();
   }
 }

@@ -10,20 +10,23 @@ using namespace skelgraph;
 
 TEST(SimRealism, DetectionAndErrorsNearTheThesisOutsideOcclusion) {
   sim::RealismOptions opt;  // seed 1, two repeats
-  for (const std::string profile : {"mssdk", "nite"}) {
-    for (const auto& scenario : sim::kThesisScenarios) {
-      const auto s = sim::simulate_figures(scenario, profile, opt);
-      const auto t = sim::thesis_figures(scenario, profile);
-      for (std::size_t g = 0; g < sim::kGroupCount; ++g) {
-        SCOPED_TRACE(profile + " " + scenario + " " + sim::group_names()[g]);
-        EXPECT_TRUE(sim::detection_close(s[g].detection_pct, t[g].detection_pct))
-            << s[g].detection_pct << " vs " << t[g].detection_pct;
-        // Known gap (README): behind the wall the thesis's trackers erred by
-        // 30-85 cm on average; the model's physical effects give less.
-        if (scenario == "occ") continue;
-        EXPECT_TRUE(sim::error_close(s[g].error_cm, t[g].error_cm)) << s[g].error_cm << " vs " << t[g].error_cm;
-      }
-    }
+  std::size_t simulations = 0;
+  const auto cells = sim::compare_with_thesis(opt, [&](const std::string&, const std::string&) { ++simulations; });
+  EXPECT_EQ(simulations, 2 * sim::kThesisScenarios.size());
+  ASSERT_EQ(cells.size(), 2 * sim::kThesisScenarios.size() * sim::kGroupCount);
+  EXPECT_EQ(cells.front().profile, "mssdk");
+  EXPECT_EQ(cells[1].scenario, sim::kThesisScenarios[1]);  // scenarios within a group
+  EXPECT_EQ(cells[sim::kThesisScenarios.size()].group, 1u);
+  for (const auto& c : cells) {
+    SCOPED_TRACE(c.profile + " " + c.scenario + " " + sim::group_names()[c.group]);
+    const auto t = sim::thesis_figures(c.scenario, c.profile)[c.group];
+    EXPECT_EQ(c.thesis.detection_pct, t.detection_pct);
+    EXPECT_EQ(c.detection_close, sim::detection_close(c.sim.detection_pct, t.detection_pct));
+    EXPECT_TRUE(c.detection_close) << c.sim.detection_pct << " vs " << t.detection_pct;
+    // Known gap (README): behind the wall the thesis's trackers erred by
+    // 30-85 cm on average; the model's physical effects give less.
+    if (c.scenario == "occ") continue;
+    EXPECT_TRUE(c.error_close) << c.sim.error_cm << " vs " << t.error_cm;
   }
 }
 

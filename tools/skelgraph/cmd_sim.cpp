@@ -23,15 +23,8 @@ namespace skelgraph::cli {
 
 sim::SimConfig sim_config(const std::vector<std::string>& assignments, const char* what,
                           const std::vector<runtime::RawParam>& extra) {
-  runtime::ParamSchema schema;
-  sim::add_sim_params(schema);
   try {
-    std::vector<runtime::RawParam> raw;
-    for (const auto& p : assignments) raw.push_back(runtime::parse_param_assignment(p, "--param " + p));
-    raw.insert(raw.end(), extra.begin(), extra.end());
-    auto cfg = sim::sim_config_from(schema.resolve(raw, what));
-    sim::Simulation probe(cfg);  // checks the configuration
-    return cfg;
+    return sim::sim_config_from_assignments(assignments, what, extra);
   } catch (const runtime::ParamError& e) {
     throw UsageError(e.what());
   } catch (const std::invalid_argument& e) {
@@ -51,56 +44,47 @@ sim::SimProgress simulated(Progress& progress) {
 }
 
 int table(const sim::RealismOptions& opt, bool json, bool check) {
+  Progress progress;
+  const auto cells = sim::compare_with_thesis(
+      opt, [&](const std::string& profile, const std::string& s) { progress("simulating " + profile + " " + s + "..."); });
+  progress.done(false);
   nlohmann::json out = nlohmann::json::array();
-  int misses = 0, cells = 0;
+  int misses = 0;
   if (!json) {
     std::printf("Detection %% (sim / thesis) and mean error of tracked joints, cm (sim / thesis); '*' = outside tolerance\n");
     std::printf("seed %llu, %d repeat(s) of each scenario, one sensor 2 m away\n",
                 static_cast<unsigned long long>(opt.seed), opt.repeats);
   }
-  for (const auto& profile : sim::TrackerProfile::names()) {
-    if (!json) {
-      std::printf("\n%-6s %-10s", profile.c_str(), "group");
+  for (std::size_t i = 0; i < cells.size(); ++i) {
+    const auto& c = cells[i];
+    const bool new_profile = i == 0 || cells[i - 1].profile != c.profile;
+    const bool new_group = new_profile || cells[i - 1].group != c.group;
+    misses += (c.detection_close ? 0 : 1) + (c.error_close ? 0 : 1);
+    if (json) {
+      out.push_back({{"profile", c.profile}, {"scenario", c.scenario}, {"group", sim::group_names()[c.group]},
+                     {"sim_detection_pct", c.sim.detection_pct}, {"thesis_detection_pct", c.thesis.detection_pct},
+                     {"sim_error_cm", std::isfinite(c.sim.error_cm) ? nlohmann::json(c.sim.error_cm) : nlohmann::json()},
+                     {"thesis_error_cm", c.thesis.error_cm}, {"detection_close", c.detection_close}, {"error_close", c.error_close}});
+      continue;
+    }
+    if (new_profile) {
+      std::printf("\n%-6s %-10s", c.profile.c_str(), "group");
       for (const auto& s : sim::kThesisScenarios) std::printf(" | %-21s", s.c_str());
       std::printf("\n");
     }
-    std::vector<sim::Figures> sims, refs;
-    Progress progress;
-    for (const auto& s : sim::kThesisScenarios) {
-      progress("simulating " + profile + " " + s + "...");
-      sims.push_back(sim::simulate_figures(s, profile, opt));
-      refs.push_back(sim::thesis_figures(s, profile));
-    }
-    progress.done(false);
-    for (std::size_t g = 0; g < sim::kGroupCount; ++g) {
-      if (!json) std::printf("%-6s %-10s", "", sim::group_names()[g]);
-      for (std::size_t k = 0; k < sims.size(); ++k) {
-        const auto& a = sims[k][g];
-        const auto& b = refs[k][g];
-        const bool det_ok = sim::detection_close(a.detection_pct, b.detection_pct);
-        const bool err_ok = std::isfinite(a.error_cm) && sim::error_close(a.error_cm, b.error_cm);
-        misses += (det_ok ? 0 : 1) + (err_ok ? 0 : 1);
-        cells += 2;
-        if (json) {
-          out.push_back({{"profile", profile}, {"scenario", sim::kThesisScenarios[k]}, {"group", sim::group_names()[g]},
-                         {"sim_detection_pct", a.detection_pct}, {"thesis_detection_pct", b.detection_pct},
-                         {"sim_error_cm", std::isfinite(a.error_cm) ? nlohmann::json(a.error_cm) : nlohmann::json()},
-                         {"thesis_error_cm", b.error_cm}, {"detection_close", det_ok}, {"error_close", err_ok}});
-        } else {
-          std::printf(" | %3.0f/%3.0f%c %5.1f/%5.1f%c", a.detection_pct, b.detection_pct, det_ok ? ' ' : '*', a.error_cm,
-                      b.error_cm, err_ok ? ' ' : '*');
-        }
-      }
-      if (!json) std::printf("\n");
-    }
+    if (new_group) std::printf("%-6s %-10s", "", sim::group_names()[c.group]);
+    std::printf(" | %3.0f/%3.0f%c %5.1f/%5.1f%c", c.sim.detection_pct, c.thesis.detection_pct, c.detection_close ? ' ' : '*',
+                c.sim.error_cm, c.thesis.error_cm, c.error_close ? ' ' : '*');
+    if (i + 1 == cells.size() || cells[i + 1].group != c.group || cells[i + 1].profile != c.profile) std::printf("\n");
   }
+  const int n = static_cast<int>(2 * cells.size());
   if (json) {
-    std::printf("%s\n", nlohmann::json{{"seed", opt.seed}, {"repeats", opt.repeats}, {"cells", cells},
+    std::printf("%s\n", nlohmann::json{{"seed", opt.seed}, {"repeats", opt.repeats}, {"cells", n},
                                        {"outside_tolerance", misses}, {"rows", out}}
                             .dump(2)
                             .c_str());
   } else {
-    std::printf("\n%d of %d figures outside tolerance (detection: 20 points; error: factor 2 or 6 cm)\n", misses, cells);
+    std::printf("\n%d of %d figures outside tolerance (detection: 20 points; error: factor 2 or 6 cm)\n", misses, n);
   }
   return check && misses > 0 ? 1 : 0;
 }
@@ -123,51 +107,43 @@ int write_poses(const std::vector<std::string>& assignments, const std::string& 
 // (calib::write_sim_boards), or the board on a simulated robot's tool
 // (calib::write_sim_robot_boards).
 struct BoardsOpts {
-  std::string dir, size = "9x6";
+  calib::RobotBoardsOptions robot;  // robot.boards: the views (without --robot, only those)
   std::vector<std::string> params;
-  double square_m = 0.08, grey_noise = 2.0, depth_noise = 1.0;
-  int views = 20, intrinsics_views = 15;
-  std::uint64_t seed = 1;
-  std::string robot_base;  // --robot: the board on the robot's tool
-  double tool_noise_mm = 1.0, tool_noise_deg = 0.1;  // ... and the error of the tool poses it reports
+  std::string size = "9x6";
+  double square_m = 0.08;
   bool json = false;
 };
 
 int write_boards(const BoardsOpts& o) {
   const auto cfg = sim_config(o.params, "sim boards");
-  calib::SimBoardsOptions b;
-  b.dir = o.dir;
-  b.grey_noise = o.grey_noise;
-  b.depth_noise = o.depth_noise;
-  b.views = o.views;
-  b.intrinsics_views = o.intrinsics_views;
-  b.seed = o.seed;
+  auto b = o.robot.boards;
   try {
     b.board = calib::Board::parse(o.size, o.square_m);
-    if (!o.robot_base.empty()) {
-      calib::RobotBoardsOptions r{b, {}, o.robot_base, o.tool_noise_mm, o.tool_noise_deg};
+    if (!o.robot.base_text.empty()) {
+      auto r = o.robot;
+      r.boards = b;
       try {
-        r.world_from_base = robot::parse_base(o.robot_base);
+        r.world_from_base = robot::parse_base(r.base_text);
       } catch (const std::exception& e) {
         throw UsageError(std::string("--robot: ") + e.what());
       }
       const auto s = calib::write_sim_robot_boards(cfg, r);
       if (o.json) {
-        std::printf("%s\n", nlohmann::json{{"dir", o.dir}, {"robot_poses", s.robot_poses}, {"views", s.views}, {"images", s.images}}.dump(2).c_str());
+        std::printf("%s\n", nlohmann::json{{"dir", b.dir}, {"robot_poses", s.robot_poses}, {"views", s.views}, {"images", s.images}}.dump(2).c_str());
       } else {
         std::printf("%s: %zu robot poses, %zu images for %zu sensors; tool poses in tool_poses.yaml, truth in truth.yaml\n",
-                    o.dir.c_str(), s.robot_poses, s.images, cfg.sensors.size());
+                    b.dir.c_str(), s.robot_poses, s.images, cfg.sensors.size());
       }
       return 0;
     }
     const auto s = calib::write_sim_boards(cfg, b);
     if (o.json) {
-      std::printf("%s\n", nlohmann::json{{"dir", o.dir}, {"sensors", cfg.sensors.size()}, {"views", s.views}, {"images", s.images}}.dump(2).c_str());
+      std::printf("%s\n", nlohmann::json{{"dir", b.dir}, {"sensors", cfg.sensors.size()}, {"views", s.views}, {"images", s.images}}.dump(2).c_str());
     } else {
       for (const auto& [sensor, own] : s.intrinsics_views) {
         std::fprintf(stderr, "%s: %zu shared views, %zu intrinsics views\n", sensor.c_str(), s.views, own);
       }
-      std::printf("%s: %zu images for %zu sensors, truth in truth.yaml\n", o.dir.c_str(), s.images, cfg.sensors.size());
+      std::printf("%s: %zu images for %zu sensors, truth in truth.yaml\n", b.dir.c_str(), s.images, cfg.sensors.size());
     }
   } catch (const calib::CalibError& e) {
     throw UsageError(e.what());
@@ -257,21 +233,21 @@ void add_sim_command(CLI::App& app, GlobalOptions&, Action& run) {
 
   auto bo = std::make_shared<BoardsOpts>();
   auto* b = cmd->add_subcommand("boards", "Render synthetic checkerboard views (colour + depth) of the simulated cell to calibrate from");
-  b->add_option("directory", bo->dir, "output directory (created)")->required();
+  b->add_option("directory", bo->robot.boards.dir, "output directory (created)")->required();
   b->add_option("-p,--param", bo->params, "sim parameter as KEY=VALUE (sensor_count, sensors)");
-  b->add_option("--views", bo->views, "views every sensor sees (default 20)")->check(CLI::Range(3, 500));
-  b->add_option("--intrinsics-views", bo->intrinsics_views, "views per sensor for its intrinsics (default 15)")->check(CLI::Range(3, 500));
+  b->add_option("--views", bo->robot.boards.views, "views every sensor sees (default 20)")->check(CLI::Range(3, 500));
+  b->add_option("--intrinsics-views", bo->robot.boards.intrinsics_views, "views per sensor for its intrinsics (default 15)")->check(CLI::Range(3, 500));
   b->add_option("--board", bo->size, "inner corners COLSxROWS (default 9x6)");
   b->add_option("--square", bo->square_m, "square size, m (default 0.08)")->check(kPositive);
-  b->add_option("--grey-noise", bo->grey_noise, "image noise, grey levels (default 2)")->check(kNonNegative);
-  b->add_option("--depth-noise", bo->depth_noise, "scale of Kinect-like depth noise (default 1)")->check(kNonNegative);
-  b->add_option("--seed", bo->seed, "random seed");
-  b->add_option("--robot", bo->robot_base,
+  b->add_option("--grey-noise", bo->robot.boards.grey_noise, "image noise, grey levels (default 2)")->check(kNonNegative);
+  b->add_option("--depth-noise", bo->robot.boards.depth_noise, "scale of Kinect-like depth noise (default 1)")->check(kNonNegative);
+  b->add_option("--seed", bo->robot.boards.seed, "random seed");
+  b->add_option("--robot", bo->robot.base_text,
                 "X,Y,Z,YAW: the board on the tool of a simulated UR5e whose base stands there (as the robot component's "
                 "`base`), --views poses facing each sensor, and the tool poses the robot reports (for calib robot)");
-  b->add_option("--tool-noise", bo->tool_noise_mm, "with --robot: error of the reported tool positions, mm per axis (sd; default 1)")
+  b->add_option("--tool-noise", bo->robot.tool_noise_mm, "with --robot: error of the reported tool positions, mm per axis (sd; default 1)")
       ->check(kNonNegative);
-  b->add_option("--tool-noise-deg", bo->tool_noise_deg, "with --robot: error of the reported tool orientations, deg (sd; default 0.1)")
+  b->add_option("--tool-noise-deg", bo->robot.tool_noise_deg, "with --robot: error of the reported tool orientations, deg (sd; default 0.1)")
       ->check(kNonNegative);
   b->add_flag("--json", bo->json, "machine-readable summary");
   b->callback([bo, &run] { run = [bo] { return write_boards(*bo); }; });

@@ -74,4 +74,26 @@ bool error_close(double sim, double thesis) {
   return std::abs(sim - thesis) <= 6.0 || (sim >= thesis / 2.0 && sim <= thesis * 2.0);
 }
 
+std::vector<ThesisCell> compare_with_thesis(
+    const RealismOptions& opt, const std::function<void(const std::string&, const std::string&)>& on_scenario) {
+  std::vector<ThesisCell> out;
+  for (const auto& profile : TrackerProfile::names()) {
+    std::vector<Figures> sims, refs;
+    for (const auto& s : kThesisScenarios) {
+      if (on_scenario) on_scenario(profile, s);
+      sims.push_back(simulate_figures(s, profile, opt));
+      refs.push_back(thesis_figures(s, profile));
+    }
+    for (std::size_t g = 0; g < kGroupCount; ++g) {
+      for (std::size_t k = 0; k < sims.size(); ++k) {
+        const auto& a = sims[k][g];
+        const auto& b = refs[k][g];
+        out.push_back({profile, kThesisScenarios[k], g, a, b, detection_close(a.detection_pct, b.detection_pct),
+                       std::isfinite(a.error_cm) && error_close(a.error_cm, b.error_cm)});
+      }
+    }
+  }
+  return out;
+}
+
 }  // namespace skelgraph::sim

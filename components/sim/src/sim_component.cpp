@@ -34,6 +34,18 @@ void add_sim_params(runtime::ParamSchema& schema) {
                   "moved to its own left); the poses published stay the calibrated ones (default: none)");
 }
 
+SimConfig sim_config_from_assignments(const std::vector<std::string>& assignments, const std::string& what,
+                                      const std::vector<runtime::RawParam>& extra) {
+  runtime::ParamSchema schema;
+  add_sim_params(schema);
+  std::vector<runtime::RawParam> raw;
+  for (const auto& p : assignments) raw.push_back(runtime::parse_param_assignment(p, "--param " + p));
+  raw.insert(raw.end(), extra.begin(), extra.end());
+  auto cfg = sim_config_from(schema.resolve(raw, what));
+  Simulation probe(cfg);  // checks the configuration
+  return cfg;
+}
+
 SimConfig sim_config_from(const runtime::Params& params) {
   SimConfig c;
   c.scenario.name = params.get<std::string>("scenario");

@@ -4,11 +4,12 @@
 // Kinects against Vicon (section 5.1): the detection rate of a joint group is
 // the share of sensor frames in which its joints report confidence 1; its
 // error is the mean distance to ground truth over those joints only.
-// `skelgraph sim table` prints the comparison; tests/unit/test_sim_realism.cpp
-// holds it to loose tolerances.
+// `skelgraph sim table` prints the comparison (compare_with_thesis);
+// tests/unit/test_sim_realism.cpp holds it to loose tolerances.
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -38,5 +39,19 @@ Figures simulate_figures(const std::string& scenario, const std::string& profile
 // or 6 cm of the thesis.
 bool detection_close(double sim, double thesis);
 bool error_close(double sim, double thesis);
+
+// One joint group of one scenario and tracker profile, simulated and in the thesis.
+struct ThesisCell {
+  std::string profile, scenario;
+  std::size_t group = 0;
+  GroupFigures sim, thesis;
+  bool detection_close = false, error_close = false;  // an error the simulator cannot give (NaN) is not close
+};
+// The whole comparison, in the order the table prints it: by tracker profile,
+// then joint group, then scenario. `on_scenario(profile, scenario)` is called
+// before each simulation (progress).
+std::vector<ThesisCell> compare_with_thesis(
+    const RealismOptions& opt,
+    const std::function<void(const std::string& profile, const std::string& scenario)>& on_scenario = {});
 
 }  // namespace skelgraph::sim

@@ -65,5 +65,11 @@ class SimComponent final : public runtime::Component {
 SimConfig sim_config_from(const runtime::Params& params);
 // The parameters both take.
 void add_sim_params(runtime::ParamSchema& schema);
+// The configuration from KEY=VALUE assignments (`--param`), then `extra`
+// (e.g. {"scenario", "walk", ...}), checked by building a simulation. Every
+// offline command that simulates uses it. Throws runtime::ParamError (naming
+// `what`) or std::invalid_argument.
+SimConfig sim_config_from_assignments(const std::vector<std::string>& assignments, const std::string& what,
+                                      const std::vector<runtime::RawParam>& extra = {});
 
 }  // namespace skelgraph::sim
