@@ -315,6 +315,53 @@ TEST(SafetyRun, QuantilesAndBadConfigurations) {
   EXPECT_THROW(skelgraph::eval::run_safety(o), std::invalid_argument);
 }
 
+TEST(SafetyRun, RunsCombineAndDropoutsParse) {
+  skelgraph::eval::SafetyRunResult a, b;
+  a.seconds = 60;
+  a.steps = 100;
+  a.stop_steps = 25;
+  a.steps_by_state = {{"RUN", 75}, {"PROTECTIVE_STOP", 25}};
+  a.time_to_stop_ms = {120, 80};
+  a.min_true_separation_m = 0.9;
+  b.seconds = 30;
+  b.steps = 300;
+  b.missed_steps = 2;
+  b.steps_by_state = {{"RUN", 300}};
+  b.time_to_stop_ms = {200};
+  b.min_true_separation_m = 0.4;
+  const auto all = skelgraph::eval::combine({a, b});
+  EXPECT_EQ(all.seconds, 90);
+  EXPECT_EQ(all.steps, 400u);
+  EXPECT_EQ(all.missed_steps, 2u);
+  EXPECT_EQ(all.steps_by_state.at("RUN"), 375u);
+  EXPECT_EQ(all.time_to_stop_ms, (std::vector<double>{120, 80, 200}));
+  EXPECT_EQ(all.min_true_separation_m, 0.4);
+  EXPECT_EQ(all.share_pct(all.stop_steps), 6.25);
+  EXPECT_EQ(skelgraph::eval::SafetyRunResult{}.share_pct(0), 0.0);
+  EXPECT_TRUE(std::isinf(skelgraph::eval::combine({}).min_true_separation_m));
+
+  const std::vector<std::string> sensors{"sensor1", "sensor2"};
+  const auto d = skelgraph::eval::parse_dropout("sensor2,20,5", sensors);
+  EXPECT_EQ(d.sensor, "sensor2");
+  EXPECT_EQ(d.from_s, 15.0);
+  EXPECT_TRUE(d.silent(16.0));
+  EXPECT_FALSE(d.silent(21.0));
+  EXPECT_TRUE(d.silent(36.0));
+  const auto error = [&](const std::string& spec) {
+    try {
+      skelgraph::eval::parse_dropout(spec, sensors);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(error("sensor1,20").find("expected SENSOR,EVERY_S,FOR_S"), std::string::npos);
+  EXPECT_NE(error("sensor1,20,5,1").find("expected SENSOR,EVERY_S,FOR_S"), std::string::npos);
+  EXPECT_NE(error("sensor9,20,5").find("no sensor 'sensor9'"), std::string::npos);
+  EXPECT_NE(error("sensor1,x,5").find("must be numbers"), std::string::npos);
+  EXPECT_NE(error("sensor1,5,20").find("0 < FOR_S < EVERY_S"), std::string::npos);
+}
+
 // Following a hand: the tool keeps the standoff on the robot's side of the
 // hand, inside the workspace; it holds without a tracked hand or with old
 // data; it stays with the person it follows while they are there.

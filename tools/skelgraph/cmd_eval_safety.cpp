@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -37,31 +36,7 @@ struct SafetyOptions {
   bool json = false;
 };
 
-// "SENSOR,EVERY_S,FOR_S": the sensor silent FOR_S seconds in every EVERY_S (from EVERY_S - FOR_S on).
-eval::SafetyRunOptions::Dropout parse_dropout(const std::string& spec, const sim::SimConfig& cfg) {
-  eval::SafetyRunOptions::Dropout d;
-  std::stringstream ss(spec);
-  std::string sensor, every, length, extra;
-  if (!std::getline(ss, sensor, ',') || !std::getline(ss, every, ',') || !std::getline(ss, length, ',') ||
-      std::getline(ss, extra, ','))
-    throw UsageError("--dropout '" + spec + "': expected SENSOR,EVERY_S,FOR_S (e.g. sensor1,20,5)");
-  if (std::none_of(cfg.sensors.begin(), cfg.sensors.end(), [&](const sim::SensorConfig& s) { return s.id == sensor; }))
-    throw UsageError("--dropout '" + spec + "': no sensor '" + sensor + "' in this cell");
-  try {
-    d.every_s = std::stod(every);
-    d.for_s = std::stod(length);
-  } catch (const std::exception&) {
-    throw UsageError("--dropout '" + spec + "': EVERY_S and FOR_S must be numbers");
-  }
-  if (!(d.every_s > 0 && d.for_s > 0 && d.for_s < d.every_s))
-    throw UsageError("--dropout '" + spec + "': need 0 < FOR_S < EVERY_S");
-  d.sensor = sensor;
-  d.from_s = d.every_s - d.for_s;
-  return d;
-}
-
 nlohmann::json run_json(const eval::SafetyRunResult& r) {
-  const auto share = [&](std::uint64_t n) { return r.steps > 0 ? 100.0 * static_cast<double>(n) / static_cast<double>(r.steps) : 0.0; };
   return {{"seconds", r.seconds},
           {"steps", r.steps},
           {"steps_by_state", r.steps_by_state},
@@ -71,8 +46,8 @@ nlohmann::json run_json(const eval::SafetyRunResult& r) {
                                {"p99", eval::quantile(r.time_to_stop_ms, 0.99)},
                                {"max", eval::quantile(r.time_to_stop_ms, 1.0)}}},
           {"reaction_ms", {{"p50", eval::quantile(r.reaction_ms, 0.5)}, {"p99", eval::quantile(r.reaction_ms, 0.99)}}},
-          {"stop_pct", share(r.stop_steps)},
-          {"unnecessary_stop_pct", share(r.unnecessary_steps)},
+          {"stop_pct", r.share_pct(r.stop_steps)},
+          {"unnecessary_stop_pct", r.share_pct(r.unnecessary_steps)},
           {"stops", r.stops},
           {"task_points_reached", r.task_points_reached},
           {"follow",
@@ -86,8 +61,7 @@ int eval_safety(const SafetyOptions& o) {
   const auto method = fusion::method_from_name(o.method);
   if (!method) throw UsageError("--method: unknown fusion method '" + o.method + "'");
   nlohmann::json runs = nlohmann::json::array();
-  eval::SafetyRunResult all;
-  all.min_true_separation_m = std::numeric_limits<double>::infinity();
+  std::vector<eval::SafetyRunResult> results;
   // Bad parameters are said before anything runs.
   sim_config(o.params, "eval safety",
              {{"scenario", "robot", "eval safety"}, {"seed", "1", "--seeds"}, {"people", "1", "--people"},
@@ -116,7 +90,13 @@ int eval_safety(const SafetyOptions& o) {
       so.uncertainty_scale = o.uncertainty_scale;
       so.arm_hides = !o.no_arm_hides;
       so.min_sensors = o.min_sensors;
-      for (const auto& spec : o.dropouts) so.dropouts.push_back(parse_dropout(spec, so.sim));
+      std::vector<std::string> sensors;
+      for (const auto& sc : so.sim.sensors) sensors.push_back(sc.id);
+      try {
+        for (const auto& spec : o.dropouts) so.dropouts.push_back(eval::parse_dropout(spec, sensors));
+      } catch (const std::invalid_argument& e) {
+        throw UsageError(std::string("--dropout ") + e.what());
+      }
       if (o.follow) {
         so.follow.emplace();
         so.follow->standoff_m = o.standoff_m;
@@ -133,23 +113,10 @@ int eval_safety(const SafetyOptions& o) {
                     eval::quantile(r.time_to_stop_ms, 0.99), eval::quantile(r.reaction_ms, 0.99), j["stop_pct"].get<double>(),
                     j["unnecessary_stop_pct"].get<double>(), static_cast<unsigned long long>(r.stops));
       }
-      all.seconds += r.seconds;
-      all.steps += r.steps;
-      for (const auto& [k, v] : r.steps_by_state) all.steps_by_state[k] += v;
-      all.missed_steps += r.missed_steps;
-      all.intrusions += r.intrusions;
-      all.unnecessary_steps += r.unnecessary_steps;
-      all.stop_steps += r.stop_steps;
-      all.stops += r.stops;
-      all.task_points_reached += r.task_points_reached;
-      all.follow_steps += r.follow_steps;
-      all.follow_moving_steps += r.follow_moving_steps;
-      all.follow_error_m.insert(all.follow_error_m.end(), r.follow_error_m.begin(), r.follow_error_m.end());
-      all.min_true_separation_m = std::min(all.min_true_separation_m, r.min_true_separation_m);
-      all.time_to_stop_ms.insert(all.time_to_stop_ms.end(), r.time_to_stop_ms.begin(), r.time_to_stop_ms.end());
-      all.reaction_ms.insert(all.reaction_ms.end(), r.reaction_ms.begin(), r.reaction_ms.end());
+      results.push_back(r);
     }
   }
+  const auto all = eval::combine(results);
   auto total = run_json(all);
   if (o.json) {
     std::printf("%s\n", nlohmann::json{{"method", o.method},

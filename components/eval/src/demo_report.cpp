@@ -75,15 +75,14 @@ ReportSection robot_section(const std::filesystem::path& report_dir) {
   o.sim.scenario.repeats = 2;
   o.trace_period_s = 0.1;
   const auto r = run_safety(o);
-  const auto pct = [&](std::uint64_t n) { return r.steps ? 100.0 * static_cast<double>(n) / static_cast<double>(r.steps) : 0.0; };
   ReportSection s;
   s.summary = {{"seconds", r.seconds},
                {"missed_steps", r.missed_steps},
                {"intrusions", r.intrusions},
                {"time_to_stop_ms_max", quantile(r.time_to_stop_ms, 1.0)},
                {"stops", r.stops},
-               {"stop_pct", pct(r.stop_steps)},
-               {"unnecessary_stop_pct", pct(r.unnecessary_steps)},
+               {"stop_pct", r.share_pct(r.stop_steps)},
+               {"unnecessary_stop_pct", r.share_pct(r.unnecessary_steps)},
                {"reaction_ms_p50", quantile(r.reaction_ms, 0.5)},
                {"reaction_ms_p99", quantile(r.reaction_ms, 0.99)},
                {"task_points_reached", r.task_points_reached}};
@@ -114,7 +113,7 @@ ReportSection robot_section(const std::filesystem::path& report_dir) {
                 "room for a useful speed) %.0f %% of the time; reaction time (the data's age, the trackers' 50 ms in it, plus the command "
                 "latency) median %.0f ms, p99 %.0f ms. <code>skelgraph eval safety</code> runs an hour of it.</p>\n",
                 r.seconds, static_cast<unsigned long long>(r.missed_steps), static_cast<unsigned long long>(r.stops),
-                pct(r.stop_steps), pct(r.unnecessary_steps), quantile(r.reaction_ms, 0.5),
+                r.share_pct(r.stop_steps), r.share_pct(r.unnecessary_steps), quantile(r.reaction_ms, 0.5),
                 quantile(r.reaction_ms, 0.99));
   s.html = std::string(head) + plot + "\n" + states + "\n";
   return s;

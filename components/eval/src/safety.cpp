@@ -4,6 +4,7 @@
 #include <cmath>
 #include <deque>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 
 #include "skelgraph/robot/arm.hpp"
@@ -245,6 +246,53 @@ SafetyRunResult run_safety(const SafetyRunOptions& o) {
   }
   r.seconds = static_cast<double>(r.steps) * dt;
   return r;
+}
+
+SafetyRunResult combine(const std::vector<SafetyRunResult>& runs) {
+  SafetyRunResult all;
+  all.min_true_separation_m = std::numeric_limits<double>::infinity();
+  const auto join = [](std::vector<double>& to, const std::vector<double>& from) { to.insert(to.end(), from.begin(), from.end()); };
+  for (const auto& r : runs) {
+    all.seconds += r.seconds;
+    all.steps += r.steps;
+    for (const auto& [k, v] : r.steps_by_state) all.steps_by_state[k] += v;
+    all.missed_steps += r.missed_steps;
+    all.intrusions += r.intrusions;
+    all.unnecessary_steps += r.unnecessary_steps;
+    all.stop_steps += r.stop_steps;
+    all.stops += r.stops;
+    all.task_points_reached += r.task_points_reached;
+    all.follow_steps += r.follow_steps;
+    all.follow_moving_steps += r.follow_moving_steps;
+    join(all.follow_error_m, r.follow_error_m);
+    all.min_true_separation_m = std::min(all.min_true_separation_m, r.min_true_separation_m);
+    join(all.time_to_stop_ms, r.time_to_stop_ms);
+    join(all.reaction_ms, r.reaction_ms);
+  }
+  return all;
+}
+
+SafetyRunOptions::Dropout parse_dropout(const std::string& spec, const std::vector<std::string>& sensors) {
+  SafetyRunOptions::Dropout d;
+  std::stringstream ss(spec);
+  std::string sensor, every, length, extra;
+  if (!std::getline(ss, sensor, ',') || !std::getline(ss, every, ',') || !std::getline(ss, length, ',') ||
+      std::getline(ss, extra, ',')) {
+    throw std::invalid_argument("'" + spec + "': expected SENSOR,EVERY_S,FOR_S (e.g. sensor1,20,5)");
+  }
+  if (std::find(sensors.begin(), sensors.end(), sensor) == sensors.end()) {
+    throw std::invalid_argument("'" + spec + "': no sensor '" + sensor + "' in this cell");
+  }
+  try {
+    d.every_s = std::stod(every);
+    d.for_s = std::stod(length);
+  } catch (const std::exception&) {
+    throw std::invalid_argument("'" + spec + "': EVERY_S and FOR_S must be numbers");
+  }
+  if (!(d.every_s > 0 && d.for_s > 0 && d.for_s < d.every_s)) throw std::invalid_argument("'" + spec + "': need 0 < FOR_S < EVERY_S");
+  d.sensor = sensor;
+  d.from_s = d.every_s - d.for_s;
+  return d;
 }
 
 }  // namespace skelgraph::eval

@@ -100,7 +100,21 @@ struct SafetyRunResult {
   std::uint64_t follow_steps = 0, follow_moving_steps = 0;
   std::vector<double> follow_error_m;
   std::vector<SafetyTracePoint> trace;  // with trace_period_s
+
+  // n steps as a share of all steps, % (0 without steps).
+  double share_pct(std::uint64_t n) const {
+    return steps > 0 ? 100.0 * static_cast<double>(n) / static_cast<double>(steps) : 0.0;
+  }
 };
+
+// Several runs as one: counts and times added, the per-event lists joined (in
+// run order), the smallest separation kept (+inf for no runs); no trace.
+SafetyRunResult combine(const std::vector<SafetyRunResult>& runs);
+
+// "SENSOR,EVERY_S,FOR_S": the sensor silent FOR_S seconds in every EVERY_S
+// (from EVERY_S - FOR_S on). Throws std::invalid_argument, quoting the spec,
+// for a malformed one, a sensor not among `sensors`, or not 0 < FOR_S < EVERY_S.
+SafetyRunOptions::Dropout parse_dropout(const std::string& spec, const std::vector<std::string>& sensors);
 
 // bringup/robot_cell.yaml's cell: the `robot` scenario watched by four
 // sensors in a ring, the arm's base 1.9 m ahead of the worker, its tool round
