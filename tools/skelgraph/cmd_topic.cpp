@@ -41,28 +41,16 @@ struct ToolSession {
 };
 
 // How to subscribe to `topic`: from our table if we know it, else from a writer discovered on the domain.
-struct TopicPlan {
-  std::string type_name;
-  bool keyed = false;
-  runtime::QosPreset qos;
-};
-
-TopicPlan plan_for(const std::string& topic, ToolSession& s, Ms timeout) {
-  if (const auto* t = runtime::find_topic(topic)) {
-    const auto* m = msg::find_message(t->type_name);
-    TopicPlan p{t->type_name, m != nullptr && m->keyed, t->qos};
-    // A tool keeps up or drops, never blocks writers (keep-all becomes 1000);
-    // and it shows every sample it can: samples arriving together (the status of
-    // every component of a process) must not overwrite each other in a queue of 1.
-    p.qos.depth = p.qos.depth == 0 ? 1000 : std::max(p.qos.depth, 100);
-    return p;
-  }
+// A tool keeps up or drops, never blocks writers (keep-all becomes 1000); and it shows every sample it can:
+// samples arriving together (the status of every component of a process) must not overwrite each other.
+runtime::ReaderPlan plan_for(const std::string& topic, ToolSession& s, Ms timeout) {
+  if (const auto* t = runtime::find_topic(topic)) return runtime::reader_plan(*t, 100, 1000);
   runtime::EndpointInfo w;
   if (!s.observer.wait_for_writer(topic, timeout, &w)) {
     throw UsageError("topic '" + topic + "': no writer found on domain " + std::to_string(s.context->config().domain) +
                      " within " + std::to_string(timeout.count()) + " ms (try `skelgraph topic list`)");
   }
-  return TopicPlan{w.type_name, w.keyed, {w.reliability, runtime::Durability::Volatile, 1000}};
+  return runtime::ReaderPlan{w.type_name, w.keyed, {w.reliability, runtime::Durability::Volatile, 1000}};
 }
 
 int list(const runtime::DdsConfig& config, double wait_s, bool json, bool all) {

@@ -57,13 +57,11 @@ Recorder::Recorder(runtime::Context& ctx, const runtime::Params& params)
   for (const auto& name : topics_) {
     const auto* t = runtime::find_topic(name);
     if (t == nullptr) throw std::invalid_argument("recorder: '" + name + "' is not a skelgraph topic");
-    const auto* m = msg::find_message(t->type_name);
-    const bool keyed = m != nullptr && m->keyed;
-    auto qos = t->qos;
-    qos.depth = std::max(qos.depth, 256);  // keep up with bursts; recording never blocks writers
+    const auto plan = runtime::reader_plan(*t, 256, 256);  // keep up with bursts; recording never blocks writers
+    const bool keyed = plan.keyed;
     const runtime::TopicInfo info = *t;
     subs_.push_back(std::make_unique<runtime::RawSubscription>(
-        ctx, t->name, t->type_name, keyed, qos,
+        ctx, t->name, t->type_name, keyed, plan.qos,
         [this, info, keyed](const msg::RawSample& s, const runtime::SampleMeta& meta) { on_sample(info, keyed, s, meta); }));
   }
 }

@@ -1,5 +1,9 @@
 #include "skelgraph/runtime/topics.hpp"
 
+#include <algorithm>
+
+#include "skelgraph/msg/message_table.hpp"
+
 namespace skelgraph::runtime {
 
 namespace {
@@ -26,6 +30,13 @@ const TopicInfo* find_topic(const std::string& name) {
     if (t.name == name) return &t;
   }
   return nullptr;
+}
+
+ReaderPlan reader_plan(const TopicInfo& topic, int min_depth, int keep_all_depth) {
+  const auto* m = msg::find_message(topic.type_name);
+  ReaderPlan p{topic.type_name, m != nullptr && m->keyed, topic.qos};
+  p.qos.depth = p.qos.depth == 0 ? keep_all_depth : std::max(p.qos.depth, min_depth);
+  return p;
 }
 
 }  // namespace skelgraph::runtime

@@ -95,4 +95,15 @@ struct TopicInfo {
 const std::vector<TopicInfo>& known_topics();
 const TopicInfo* find_topic(const std::string& name);
 
+// How a tool that only reads (the recorder, `topic echo`, `topic hz`)
+// subscribes to a topic of the table: its type, whether it is keyed, and its
+// QoS with a deeper history, so that bursts are kept and writers are never
+// blocked: keep-all becomes `keep_all_depth`, a shorter history `min_depth`.
+struct ReaderPlan {
+  std::string type_name;
+  bool keyed = false;
+  QosPreset qos;
+};
+ReaderPlan reader_plan(const TopicInfo& topic, int min_depth, int keep_all_depth);
+
 }  // namespace skelgraph::runtime
