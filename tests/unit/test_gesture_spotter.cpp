@@ -255,6 +255,42 @@ TEST(Spotting, PointingLandsWithinReachAndLeavesTheOtherArmFree) {
   EXPECT_EQ(spot(c, both, allow).size(), 1u);
 }
 
+TEST(Spotting, PointingIsAStraightArmFromAnUprightTrunk) {
+  const auto c = always_point();
+  EXPECT_EQ(SpotterOptions{}.min_straightness, 0.90);  // on everywhere: it needs no frame
+  EXPECT_EQ(SpotterOptions{}.max_lean_m, 0.0);         // needs a level world: the cell's, not a recording's camera
+  EXPECT_EQ(skelgraph::gesture::sim_spotter_options().max_lean_m, 0.07);
+  SpotterOptions o = any_ray();
+  o.max_lean_m = 0.07;
+  // Straight and upright: pointing, its straightness and lean reported.
+  const auto straight = spot(c, arm_stream(gesture(2.0, 55), 8), o);
+  ASSERT_EQ(straight.size(), 1u);
+  EXPECT_NEAR(straight[0].straightness, 1.0, 1e-9);
+  EXPECT_NEAR(straight[0].lean_m, 0.0, 1e-9);
+  // The elbow bent by 60 degrees (shoulder to hand 0.87 of the arm): a reach, not pointing.
+  auto bent = arm_stream(gesture(2.0, 55), 8);
+  for (auto& s : bent) {
+    const Vector3d sh = s[JointId::RightShoulder].position, el = s[JointId::RightElbow].position;
+    const Vector3d upper = el - sh;
+    const Eigen::AngleAxisd turn(-60 * M_PI / 180, Vector3d::UnitX());  // the forearm up: still raised above 35 degrees
+    s[JointId::RightHand].position = el + turn * upper;
+  }
+  const double bent_share = (bent[200][JointId::RightHand].position - bent[200][JointId::RightShoulder].position).norm() / 0.6;
+  ASSERT_NEAR(bent_share, std::cos(30 * M_PI / 180), 1e-6);
+  EXPECT_TRUE(spot(c, bent, o).empty());
+  SpotterOptions any_arm = o;
+  any_arm.min_straightness = 0;
+  EXPECT_EQ(spot(c, bent, any_arm).size(), 1u);
+  // Leaning forward to a bench: the neck 15 cm ahead of the torso.
+  auto leaning = arm_stream(gesture(2.0, 55), 8);
+  for (auto& s : leaning) s[JointId::Neck].position.z() += 0.15;
+  EXPECT_TRUE(spot(c, leaning, o).empty());
+  EXPECT_EQ(spot(c, leaning, any_ray()).size(), 1u);  // lean not asked for (a recording's tilted camera)
+  auto slight = arm_stream(gesture(2.0, 55), 8);
+  for (auto& s : slight) s[JointId::Neck].position.x() += 0.05;  // 5 cm: within the tracker's error of upright
+  EXPECT_EQ(spot(c, slight, o).size(), 1u);
+}
+
 TEST(Spotting, AConfirmationDropsPointingHeldBriefly) {
   const auto c = always_point();
   // Raised over 0.5 s to 55 degrees at 2 s, held `hold` s, lowered over 0.5 s.

@@ -98,6 +98,13 @@ CLI::Option* add_spotter_options(CLI::App* c, GestureOptions& o) {
   c->add_option("--min-confidence", o.spot.min_confidence,
                 "events less sure than this (1 - exp(-margin) over the next class) are dropped (default 0)")
       ->check(CLI::Range(0.0, 1.0));
+  c->add_option("--min-straightness", o.spot.min_straightness,
+                "pointing: shoulder to hand over the arm's length, averaged over the hold, at least this (1: straight; 0: any; default 0.9)")
+      ->check(CLI::Range(0.0, 1.0));
+  c->add_option("--max-lean", o.spot.max_lean_m,
+                "pointing: the neck at most this far (m) off the torso horizontally over the hold, the trunk upright (0: any; "
+                "default 0.07 in gesture sim, whose world is level; 0 in gesture spot: a recording's camera may be tilted)")
+      ->check(CLI::Range(0.0, 1.0));
   return max_target;
 }
 
@@ -202,8 +209,9 @@ void add_gesture_command(CLI::App& app, GlobalOptions&, Action& run) {
   sm->add_option("--out", o->out, "write the trained classifier (JSON), e.g. for the gesture component");
   auto* sim_max_target = add_spotter_options(sm, *o);
   sm->add_option("--window", o->spot.window, "s over which hand speed is measured (default 0.25)")->check(CLI::Range(0.03, 2.0));
-  sm->callback([o, sim_max_target, &run] {
+  sm->callback([o, sm, sim_max_target, &run] {
     if (sim_max_target->count() == 0) o->spot.max_target = sim_spotter_options().max_target;  // the cell's floor
+    if (sm->count("--max-lean") == 0) o->spot.max_lean_m = sim_spotter_options().max_lean_m;  // its level world
     run = [o] { return gesture_sim(*o); };
   });
 

@@ -40,6 +40,8 @@ nlohmann::json event_json(const SpottedEvent& e) {
     j["arm"] = e.arm;
     j["ray_origin"] = {e.ray_origin.x(), e.ray_origin.y(), e.ray_origin.z()};
     j["ray_direction"] = {e.ray_direction.x(), e.ray_direction.y(), e.ray_direction.z()};
+    j["straightness"] = e.straightness;
+    if (std::isfinite(e.lean_m)) j["lean_m"] = e.lean_m;
   }
   if (e.has_target) {
     j["target"] = {e.target.x(), e.target.y(), e.target.z()};

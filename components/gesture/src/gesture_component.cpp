@@ -65,6 +65,8 @@ runtime::ComponentInfo GestureComponent::describe() {
       .add_bool("other_arm_free", true, "pointing needs the other arm not held out as well (carrying, a stretch)")
       .add_double("confirm_s", 0.0, "pointing must stay held this long after hold_s or it is dropped (a confirmation)", 0.0, 10.0)
       .add_double("min_confidence", 0.0, "events less sure than this (1 - exp(-margin) over the next class) are dropped", 0.0, 1.0)
+      .add_double("min_straightness", 0.90, "pointing: shoulder to hand over the arm's length, averaged over the hold, at least this (0: any)", 0.0, 1.0)
+      .add_double("max_lean_m", 0.07, "pointing: the neck at most this far off the torso horizontally over the hold, m (0: any)", 0.0, 1.0)
       .add_double("person_timeout_ms", 2000.0, "a person not seen this long is forgotten", 10.0, 60000.0);
   return info;
 }
@@ -82,6 +84,8 @@ SpotterOptions spotter_options(const runtime::Params& params) {
   o.other_arm_free = params.get<bool>("other_arm_free");
   o.confirm = params.get<double>("confirm_s");
   o.min_confidence = params.get<double>("min_confidence");
+  o.min_straightness = params.get<double>("min_straightness");
+  o.max_lean_m = params.get<double>("max_lean_m");
   o.surfaces.clear();
   for (const auto& s : runtime::rejoin_named_items(params.get<std::vector<std::string>>("surfaces"))) o.surfaces.push_back(parse_surface(s));
   return o;

@@ -234,6 +234,7 @@ std::vector<SimSession> held_out_sessions(int sessions, std::uint64_t seed, cons
 SpotterOptions sim_spotter_options() {
   SpotterOptions o;
   o.max_target = 4.0;
+  o.max_lean_m = 0.07;
   return o;
 }
 
@@ -319,6 +320,8 @@ Classifier train_on_sim(int sessions, std::uint64_t seed, const ClassifierOption
   SpotterOptions spot = spot_options;
   spot.min_confidence = 0.0;
   spot.confirm = 0.0;
+  spot.min_straightness = 0.0;
+  spot.max_lean_m = 0.0;
   std::vector<SimSession> train;
   for (int i = 0; i < sessions; ++i) {
     train.push_back(simulate_session(seed * 1000 + static_cast<std::uint64_t>(i), {}, 1.0, "point",

@@ -129,7 +129,7 @@ std::vector<SpottedEvent> Spotter::step(const skeleton::Skeleton& s, const Wrist
     if (moving) {
       while (rays.size() > 1 && rays.back().t > cut) rays.pop_back();
     }
-    out.push_back(release_aiming(rays, rays.empty() ? aiming_->end_ns : std::max(aiming_->end_ns, rays.back().t)));
+    if (auto e = release_aiming(rays, rays.empty() ? aiming_->end_ns : std::max(aiming_->end_ns, rays.back().t))) out.push_back(*e);
   };
   const double dt = have_last_ && t > last_ns_ ? static_cast<double>(t - last_ns_) * 1e-9 : 1.0 / 30;
   const Eigen::VectorXd x = features_.step(s, nullptr, nullptr, wrists);
@@ -138,6 +138,16 @@ std::vector<SpottedEvent> Spotter::step(const skeleton::Skeleton& s, const Wrist
     Vector3d a = s[JointId::RightShoulder].position - s[JointId::LeftShoulder].position;
     a.y() = 0;
     if (a.norm() > 0.05) across_ = a.normalized();
+  }
+  // The trunk's lean (a reach to a bench bends it; pointing stands upright):
+  // how far the neck is off the torso horizontally. A distance, not an angle:
+  // a tracker's error is centimetres whatever the body's size, and a short
+  // trunk's angle would be mostly that error.
+  double lean_m = std::numeric_limits<double>::quiet_NaN();
+  if (s[JointId::Torso].confidence >= skeleton::kTracked && s[JointId::Neck].confidence >= skeleton::kTracked) {
+    Vector3d off = s[JointId::Neck].position - s[JointId::Torso].position;
+    off.y() = 0;
+    lean_m = off.norm();
   }
   // Hands: speed, rest, extension, holds.
   bool at_rest[2], still[2];
@@ -181,7 +191,7 @@ std::vector<SpottedEvent> Spotter::step(const skeleton::Skeleton& s, const Wrist
       const ArmFrame arm(across_, side == 1);
       const auto& pc = c_.pointing_correction();
       const Vector3d sh0 = sh - arm.to_world(pc.shoulder), ha0 = ha - arm.to_world(pc.hand);
-      rays_[side].push_back({t, sh0, (ha0 - sh0).normalized(), false});
+      rays_[side].push_back({t, sh0, (ha0 - sh0).normalized(), false, (ha - sh).norm() / std::max(len, 1e-9), lean_m});
       if (aiming_ && aiming_side_ == side && static_cast<double>(t - hold_since_[side]) * 1e-9 >= std::max(o_.aim, o_.hold + o_.confirm)) {
         send_aimed(side, false);
       }
@@ -258,7 +268,7 @@ std::vector<SpottedEvent> Spotter::close(std::int64_t now_ns, bool final) {
   std::vector<SpottedEvent> out;
   if (aiming_) {  // the segment ends while the ray is still being gathered (a hold cut short by the end of data)
     if (static_cast<double>(now_ns - aiming_hold_ns_) * 1e-9 < o_.hold + o_.confirm) aiming_.reset();  // unconfirmed
-    else out.push_back(release_aiming(rays_[aiming_side_].empty() ? best_rays_ : rays_[aiming_side_], now_ns));
+    else if (auto e = release_aiming(rays_[aiming_side_].empty() ? best_rays_ : rays_[aiming_side_], now_ns)) out.push_back(*e);
   }
   const double length = segment_.empty() ? 0.0 : static_cast<double>(segment_.back().t - segment_.front().t) * 1e-9;
   if (!fired_ && length >= o_.min_length) {
@@ -272,22 +282,35 @@ std::vector<SpottedEvent> Spotter::close(std::int64_t now_ns, bool final) {
   return out;
 }
 
-SpottedEvent Spotter::release_aiming(const Rays& rays, std::int64_t end_ns) {
+std::optional<SpottedEvent> Spotter::release_aiming(const Rays& rays, std::int64_t end_ns) {
   SpottedEvent e = std::move(*aiming_);
   aiming_.reset();
   aim(e, rays, aiming_side_);
   e.end_ns = end_ns;
+  if (!pointing_posture(e)) return std::nullopt;
   return e;
+}
+
+bool Spotter::pointing_posture(const SpottedEvent& e) const {
+  if (o_.min_straightness > 0 && e.straightness < o_.min_straightness) return false;
+  if (o_.max_lean_m > 0 && std::isfinite(e.lean_m) && e.lean_m > o_.max_lean_m) return false;
+  return true;
 }
 
 void Spotter::aim(SpottedEvent& e, const Rays& rays, int side) const {
   if (rays.empty() || side < 0) return;
   Vector3d origin = Vector3d::Zero(), dir = Vector3d::Zero();
+  double straight = 0.0, lean = 0.0;
+  int leans = 0;
   for (const auto& r : rays) {
     origin += r.origin;
     dir += r.direction;
+    straight += r.straight;
+    if (std::isfinite(r.lean_m)) lean += r.lean_m, ++leans;
   }
   origin /= static_cast<double>(rays.size());
+  e.straightness = straight / static_cast<double>(rays.size());
+  e.lean_m = leans > 0 ? lean / leans : std::numeric_limits<double>::quiet_NaN();
   e.has_ray = dir.norm() > 1e-9;
   e.ray_origin = origin;
   e.arm = kSideName[side];
@@ -345,6 +368,7 @@ std::optional<SpottedEvent> Spotter::decide(std::int64_t now_ns, bool early) {
       if (2 * both > static_cast<std::ptrdiff_t>(rays.size())) return std::nullopt;  // both arms out: not pointing
     }
     if (o_.max_target > 0 && (!e.has_target || (e.target - e.ray_origin).norm() > o_.max_target)) return std::nullopt;
+    if (!pointing_posture(e)) return std::nullopt;
   }
   return e;
 }

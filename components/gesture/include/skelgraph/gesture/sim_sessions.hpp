@@ -31,8 +31,9 @@ struct SimSession {
 };
 
 // The spotter in the simulated cell: pointing lands on its floor within 4 m
-// of the shoulder (max_target; where the surfaces of a recording are is not
-// known, so `gesture spot` leaves it off).
+// of the shoulder (max_target) and the trunk is upright (max_lean_m 0.07, in
+// its level world frame); where the surfaces of a recording are and how its
+// camera is tilted are not known, so `gesture spot` leaves both off.
 SpotterOptions sim_spotter_options();
 
 // The pointing arm's joint offsets (PointingCorrection::shoulder, hand): the

@@ -29,6 +29,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -81,6 +82,12 @@ struct SpotterOptions {
   bool other_arm_free = true;  // the other arm not held out as well (carrying, a stretch, hands on the knees)
   double min_confidence = 0.0; // events less sure than this are dropped (the operating point: recall against false alarms)
   double confirm = 0.0;        // s: pointing must stay held this long after `hold` or it is dropped (a confirmation; 0: none)
+  // Pointing's posture, averaged over the hold (docs/experiments/2026-12-05-pointing-posture.md):
+  double min_straightness = 0.90; // shoulder -> hand over the arm's length, at least (1: straight; 0: any). Real
+                                  // adults point with the elbow a little bent: 0.93 lost one of Kinder-Gator's ten
+  double max_lean_m = 0.0;        // the neck off the torso horizontally, at most, m (0: any). Needs a level world
+                                  // frame: the simulated cell and the `gesture` component use 0.07; a recording's
+                                  // camera may be tilted, so `gesture spot` leaves it off
   std::string point_label = "point";
   // Other gestures made by holding an arm out (a raised palm: "stop"): fired
   // early too, once held `hold` s, without a ray; the rest when their segment closes.
@@ -101,6 +108,9 @@ struct SpottedEvent {
   std::string target_name;
   std::string arm;                        // "left" / "right" for pointing
   Eigen::Vector3d out = Eigen::Vector3d::Zero();  // horizontal, away from the body on the pointing arm's side
+  // Pointing: how the body held the ray, averaged over it.
+  double straightness = 0.0;  // shoulder -> hand over the arm's length (1: the arm straight)
+  double lean_m = std::numeric_limits<double>::quiet_NaN();  // the neck off the torso horizontally, m
 };
 
 // One arm's body axes (PointingCorrection's joint offsets are in them), from
@@ -139,10 +149,14 @@ class Spotter {
     std::int64_t t;
     Eigen::Vector3d origin, direction;
     bool both = false;  // the other arm was held out too
+    double straight = 1.0;  // shoulder -> hand over the arm's length (1: straight)
+    double lean_m = std::numeric_limits<double>::quiet_NaN();  // the neck off the torso horizontally (NaN: not tracked)
   };
   using Rays = std::vector<RaySample>;
   void aim(SpottedEvent& e, const Rays& rays, int side) const;  // the ray and its target
-  SpottedEvent release_aiming(const Rays& rays, std::int64_t end_ns);  // the gathered pointing event, aimed
+  // The gathered pointing event, aimed; nullopt when the whole hold no longer looks like pointing.
+  std::optional<SpottedEvent> release_aiming(const Rays& rays, std::int64_t end_ns);
+  bool pointing_posture(const SpottedEvent& e) const;  // straight arm, upright trunk (min_straightness, max_lean_m)
 
   const Classifier& c_;
   SpotterOptions o_;
