@@ -75,6 +75,12 @@ for label, n in q["events"].items():
     assert n == sum(s["events"].get(label, 0) for s in q["scenarios"]), (label, q)
     assert abs(q["per_hour"][label] - n / q["hours"]) < 1e-6, (label, q)
 assert "point" in q["per_hour"], q
+# The operating curve: the options given first (the figures above), then each point spotted again.
+d = json.load(open(sys.argv[1]))
+c = d["operating_curve"]
+assert len(c) == 10 and (c[0]["min_confidence"], c[0]["confirm_s"]) == (0, 0), c
+assert c[0]["recall"] == d["spotting"]["recall"] and abs(c[0]["false_per_hour"] - q["per_hour"]["point"]) < 1e-9, c
+assert [p["confirm_s"] for p in c] == [0] * 5 + [0.5] * 5, c
 print("false pointing events per hour: %.1f over %.2f h (%s)" % (q["per_hour"]["point"], q["hours"],
       ", ".join("%s %d" % (s["scenario"], s["events"].get("point", 0)) for s in q["scenarios"])))
 PY

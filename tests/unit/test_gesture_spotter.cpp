@@ -427,3 +427,32 @@ TEST(BuiltinModel, AMissingModelNamesItsFileAndTheBuildTarget) {
   EXPECT_EQ(builtin_model_dir().string(), before);
   EXPECT_THROW(load_builtin_model("stop"), std::invalid_argument);
 }
+
+TEST(BuiltinModel, TheOperatingCurveIsSpottingAgainAtEachPoint) {
+  const auto model = load_builtin_model("sim");
+  const auto test = held_out_sessions(2, 78);
+  const auto quiet = quiet_sessions({"work", "box"}, 1, 78);
+  const auto opts = skelgraph::gesture::sim_spotter_options();
+  const auto curve = skelgraph::gesture::operating_curve(model, test, quiet, opts, {0.0, 0.5, 0.9}, {0.0, 0.5}, 2);
+  ASSERT_EQ(curve.size(), 6u);
+  EXPECT_EQ(curve[0].min_confidence, 0.0);
+  EXPECT_EQ(curve[0].confirm, 0.0);
+  EXPECT_EQ(curve[4].min_confidence, 0.5);
+  EXPECT_EQ(curve[4].confirm, 0.5);
+  // The first point is the options as given: the same as spotting once.
+  std::vector<SpottingReport> reports;
+  for (const auto& s : spot_sessions(model, test, opts)) reports.push_back(s.report);
+  const auto r = combine(reports);
+  EXPECT_EQ(curve[0].recall, r.recall);
+  EXPECT_EQ(curve[0].precision, r.precision);
+  EXPECT_EQ(curve[0].false_per_hour, skelgraph::gesture::spot_quiet(model, quiet, opts).per_hour("point"));
+  EXPECT_GT(curve[0].recall, 0.5);
+  // Here, asking for more confidence, or a confirmation, finds no more.
+  for (std::size_t k = 0; k < curve.size(); ++k) {
+    if (k % 3 != 0) {
+      EXPECT_LE(curve[k].recall, curve[k - 1].recall) << k;
+      EXPECT_LE(curve[k].false_per_hour, curve[k - 1].false_per_hour) << k;
+    }
+    if (k >= 3) EXPECT_LE(curve[k].recall, curve[k - 3].recall) << k;
+  }
+}

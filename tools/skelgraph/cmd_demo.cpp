@@ -113,7 +113,7 @@ int run_demo(const DemoOptions& o, GlobalOptions& g) {
     out["live_evaluation"] = live.summary;
     std::fprintf(stderr, "[demo 3/5] pointing: the built-in classifier (trained by the build on %d simulated sessions), "
                  "spotting in 4 others\n", gesture::kTrainSessions);
-    const auto pointing = pointing_section();
+    const auto pointing = pointing_section(report_dir);
     out["pointing"] = pointing.summary;
     std::fprintf(stderr, "[demo 4/5] the robot cell: speed and separation monitoring judged against the truth (offline)\n");
     const auto robot = robot_section(report_dir);

@@ -2,6 +2,7 @@
 // measure on held-out simulated sessions and sessions without gestures.
 
 #include <cmath>
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -68,11 +69,21 @@ int gesture_sim(const GestureOptions& o) {
   const auto test = held_out_sessions(o.test_sessions, o.seed, [&](int d, int t) { progress("simulating and fusing test sessions", d, t); },
                                       o.test_noise_scale, o.test_height);
   const auto spotted = spot_sessions(model, test, o.spot);
-  const auto quiet = spot_quiet(model,
-                                quiet_sessions(o.quiet_scenarios, o.quiet_sessions, o.seed,
-                                               [&](int d, int t) { progress("simulating and fusing sessions without gestures", d, t); },
-                                               o.test_noise_scale),
-                                o.spot);
+  const auto quiet_runs = quiet_sessions(o.quiet_scenarios, o.quiet_sessions, o.seed,
+                                         [&](int d, int t) { progress("simulating and fusing sessions without gestures", d, t); },
+                                         o.test_noise_scale);
+  const auto quiet = spot_quiet(model, quiet_runs, o.spot);
+  // Recall against false events per hour, the operating point chosen at spotting time.
+  std::vector<double> confidences{0.0, 0.25, 0.5, 0.75, 0.9}, confirms{0.0, 0.5};
+  if (std::find(confidences.begin(), confidences.end(), o.spot.min_confidence) == confidences.end()) confidences.push_back(o.spot.min_confidence);
+  if (std::find(confirms.begin(), confirms.end(), o.spot.confirm) == confirms.end()) confirms.push_back(o.spot.confirm);
+  const auto curve = operating_curve(model, test, quiet_runs, o.spot, confidences, confirms, c.threads);
+  nlohmann::json curve_json = nlohmann::json::array();
+  for (const auto& p : curve) {
+    curve_json.push_back({{"min_confidence", p.min_confidence}, {"confirm_s", p.confirm}, {"recall", p.recall},
+                          {"precision", p.precision}, {"false_per_hour", p.false_per_hour},
+                          {"median_latency_from_hold_s", p.median_latency_hold_s}});
+  }
   nlohmann::json quiet_json{{"hours", quiet.hours}, {"events", quiet.events}, {"per_hour", nlohmann::json::object()},
                             {"scenarios", nlohmann::json::array()}};
   for (const auto& [label, n] : quiet.events) quiet_json["per_hour"][label] = quiet.per_hour(label);
@@ -138,6 +149,7 @@ int gesture_sim(const GestureOptions& o) {
                                                     model.pointing_correction().hand.z()}}}},
                                         {"spotting", to_json(r)},
                                         {"false_alarms", quiet_json},
+                                        {"operating_curve", curve_json},
                                         {"spotted_within_15_cm", within(r.target_error_m)},
                                         {"whole_hold_reference", whole_json},
                                         {"sessions", per},
@@ -164,6 +176,9 @@ int gesture_sim(const GestureOptions& o) {
   }
   std::printf("false pointing events while nobody points: %.1f per hour (%d in %.0f s of %s)\n", quiet.per_hour("point"),
               quiet.events.count("point") ? quiet.events.at("point") : 0, quiet.hours * 3600.0, by.c_str());
+  std::printf("operating points (--min-confidence, --confirm): recall / false pointing events per hour:");
+  for (const auto& p : curve) std::printf("%s %.2f, %.2f s: %.3f / %.1f", &p == &curve.front() ? "" : ";", p.min_confidence, p.confirm, p.recall, p.false_per_hour);
+  std::printf("\n");
   if (!r.target_error_m.empty())
     std::printf("target on the floor: median error %.1f cm, largest %.1f cm, %td of %zu within 15 cm; ray direction: median %.1f deg off\n",
                 100 * r.median_target_error_m, 100 * r.max_target_error_m, within(r.target_error_m), r.target_error_m.size(),

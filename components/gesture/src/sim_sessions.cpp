@@ -4,6 +4,7 @@
 #include <map>
 #include <optional>
 
+#include "classifier_internal.hpp"
 #include "skelgraph/eval/offline.hpp"
 #include "skelgraph/sim/simulation.hpp"
 
@@ -281,6 +282,30 @@ QuietReport spot_quiet(const Classifier& model, const std::vector<SimSession>& s
     }
   }
   return r;
+}
+
+std::vector<OperatingPoint> operating_curve(const Classifier& model, const std::vector<SimSession>& test,
+                                            const std::vector<SimSession>& quiet, const SpotterOptions& options,
+                                            const std::vector<double>& min_confidences, const std::vector<double>& confirms,
+                                            int threads) {
+  std::vector<OperatingPoint> out;
+  for (const double confirm : confirms) {
+    for (const double min_confidence : min_confidences) out.push_back({min_confidence, confirm});
+  }
+  detail::parallel_for(static_cast<int>(out.size()), threads, [&](int i) {
+    auto& p = out[static_cast<std::size_t>(i)];
+    SpotterOptions o = options;
+    o.confirm = p.confirm;
+    o.min_confidence = p.min_confidence;
+    std::vector<SpottingReport> reports;
+    for (const auto& s : spot_sessions(model, test, o)) reports.push_back(s.report);
+    const auto r = combine(reports);
+    p.recall = r.recall;
+    p.precision = r.precision;
+    p.median_latency_hold_s = r.median_latency_hold_s;
+    p.false_per_hour = spot_quiet(model, quiet, o).per_hour(o.point_label);
+  });
+  return out;
 }
 
 std::vector<SessionSpotting> spot_sessions(const Classifier& model, const std::vector<SimSession>& sessions,

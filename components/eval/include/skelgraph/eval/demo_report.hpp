@@ -17,8 +17,9 @@ struct ReportSection {
   std::string html;
 };
 
-// The built-in pointing model ("sim") on 4 held-out sessions and one quiet session of each scenario.
-ReportSection pointing_section();
+// The built-in pointing model ("sim") on 4 held-out sessions and 4 quiet sessions of each scenario, with its
+// operating curve (recall against false events per hour); writes pointing_curve.svg into `dir`.
+ReportSection pointing_section(const std::filesystem::path& dir);
 // The robot cell of bringup/robot_cell.yaml with two workers; writes robot_separation.svg and robot_state.svg into `dir`.
 ReportSection robot_section(const std::filesystem::path& dir);
 

@@ -84,6 +84,21 @@ struct QuietReport {
 };
 QuietReport spot_quiet(const Classifier& model, const std::vector<SimSession>& sessions, const SpotterOptions& options = sim_spotter_options());
 
+// One operating point of pointing: spotting with these at spotting time.
+struct OperatingPoint {
+  double min_confidence = 0.0, confirm = 0.0;  // SpotterOptions'
+  double recall = 0.0, precision = 0.0;        // on held-out pointing sessions
+  double false_per_hour = 0.0;                 // pointing events per hour where nobody gestures
+  double median_latency_hold_s = 0.0;          // from the hold's start to the event
+};
+// Pointing spotted again at every pair of (min_confidence, confirm), the rest
+// of `options` kept: recall and precision on `test`, false pointing events per
+// hour on `quiet`. In the order given, confirm outer; `threads` points at once.
+std::vector<OperatingPoint> operating_curve(const Classifier& model, const std::vector<SimSession>& test,
+                                            const std::vector<SimSession>& quiet, const SpotterOptions& options,
+                                            const std::vector<double>& min_confidences = {0.0, 0.25, 0.5, 0.75, 0.9},
+                                            const std::vector<double>& confirms = {0.0, 0.5}, int threads = 2);
+
 // Labelled clips cut from sessions: each true gesture (action point, wave or
 // stretch; from `pad` s before to `pad` s after) and one rest clip per rest
 // span longer than 1 s (action rest). Subject: "sim<seed index>".
