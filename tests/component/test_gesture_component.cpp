@@ -8,8 +8,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <string>
 
+#include "../support/temp_dir.hpp"
 #include "../support/test_support.hpp"
 #include "skelgraph/gesture/builtin_models.hpp"
 #include "skelgraph/gesture/sim_sessions.hpp"
@@ -105,4 +107,27 @@ TEST(GestureComponent, SpotsInAStreamWhatTheCoreSpotsAndForgetsAPersonWhoLeft) {
   EXPECT_EQ(d["people_seen"], 1) << d;
   EXPECT_EQ(d["people_left"], 1) << d;
   EXPECT_EQ(d["people"], 0) << d;
+}
+
+TEST(GestureComponent, CutsWhereTheModelSaysUnlessItsParametersSay) {
+  auto model = gesture::load_builtin_model("sim");
+  model.set_operating_point({0.4, 0.5});
+  const auto path = test::fresh_path("gesture_operating_point.json");
+  model.save(path.string());
+  const auto registry = builtin_registry();
+  const auto cut = [&](std::vector<RawParam> raw) {
+    raw.push_back({"model", path.string(), "test"});
+    Graph graph(registry, test::test_config(), 100ms);
+    graph.add("gesture", "gesture", registry.find("gesture")->info.params.resolve(raw, "gesture"));
+    graph.start();
+    graph.stop();
+    return graph.report().at(0).details.at("operating_point");
+  };
+  const auto own = cut({});
+  EXPECT_EQ(own["min_confidence"], 0.4) << own;
+  EXPECT_EQ(own["confirm_s"], 0.5) << own;
+  const auto given = cut({{"min_confidence", "0.1", "test"}, {"confirm_s", "0", "test"}});
+  EXPECT_EQ(given["min_confidence"], 0.1) << given;
+  EXPECT_EQ(given["confirm_s"], 0.0) << given;
+  std::filesystem::remove(path);
 }

@@ -173,6 +173,15 @@ json_check "$WORK/stream_spot.json" 'len(d["files"]) == 2 and all(len(f["events"
 "$S" gesture spot --model "$WORK/model.json" --format msrc12 "$MS"/P1_1_1_p21.csv --json >"$WORK/clip_model.json" \
   2>"$WORK/clip_model.err" || fail "a clip classifier given to spot --model: $(cat "$WORK/clip_model.err")"
 json_check "$WORK/clip_model.json" 'len(d["files"]) == 1 and "events_per_hour" in d'
+# The operating point travels with a model: written by gesture sim --out, used by spot unless given.
+"$S" gesture sim --train-sessions 4 --train-quiet-sessions 1 --test-sessions 1 --quiet-sessions 1 --min-confidence 0.3 \
+  --confirm 0.25 --out "$WORK/op.json" --json >"$WORK/op_sim.json" 2>"$WORK/op_sim.err" || fail "sim --out: $(cat "$WORK/op_sim.err")"
+json_check "$WORK/op_sim.json" 'd["operating_point"]["min_confidence"] == 0.3 and d["operating_point"]["confirm_s"] == 0.25 and 0 <= d["operating_point"]["recall"] <= 1'
+"$S" gesture spot --model "$WORK/op.json" --format msrc12 "$MS"/P1_1_1_p21.csv --json >"$WORK/op_spot.json" 2>/dev/null || fail "spot with op.json"
+json_check "$WORK/op_spot.json" 'd["operating_point"] == {"min_confidence": 0.3, "confirm_s": 0.25}'
+"$S" gesture spot --model "$WORK/op.json" --min-confidence 0 --format msrc12 "$MS"/P1_1_1_p21.csv --json >"$WORK/op_spot0.json" 2>/dev/null ||
+  fail "spot --min-confidence 0"
+json_check "$WORK/op_spot0.json" 'd["operating_point"] == {"min_confidence": 0, "confirm_s": 0.25}'
 ok "stream spotter trained on two people, spotting the third's streams: macro F1 $(json_get "$WORK/stream_spot.json" 'round(d["macro_f1"], 3)')"
 
 # A clip classifier through the live spotter over recordings where nobody

@@ -388,6 +388,20 @@ TEST(Classifier, SavesAndLoadsAndRefusesMalformedFiles) {
   j["pointing_correction"].erase("shoulder_offset_m");  // a model from before the joint offsets: none
   j["pointing_correction"].erase("hand_offset_m");
   EXPECT_EQ(Classifier::from_json(j).pointing_correction().hand, Eigen::Vector3d::Zero());
+  // The operating point travels with the model; a model without one cuts nowhere.
+  model.set_operating_point({0.4, 0.5});
+  j = model.to_json();
+  EXPECT_EQ(Classifier::from_json(j).operating_point().min_confidence, 0.4);
+  EXPECT_EQ(Classifier::from_json(j).operating_point().confirm_s, 0.5);
+  j["operating_point"]["min_confidence"] = 1.5;
+  EXPECT_NE(error_of([&] { Classifier::from_json(j); }).find("'operating_point.min_confidence' must be a number from 0 to 1"),
+            std::string::npos);
+  j["operating_point"] = {{"min_confidence", 0.2}};
+  EXPECT_NE(error_of([&] { Classifier::from_json(j); }).find("'operating_point.confirm_s' must be a number from 0 to 10"),
+            std::string::npos);
+  j.erase("operating_point");
+  EXPECT_EQ(Classifier::from_json(j).operating_point().min_confidence, 0.0);
+  EXPECT_EQ(Classifier::from_json(j).operating_point().confirm_s, 0.0);
   j = model.to_json();
   j["version"] = 2;
   EXPECT_NE(error_of([&] { Classifier::from_json(j); }).find("unsupported 'version'"), std::string::npos);

@@ -93,10 +93,11 @@ CLI::Option* add_spotter_options(CLI::App* c, GestureOptions& o) {
   c->add_option("--other-arm-free", o.spot.other_arm_free,
                 "pointing needs the other arm not held out as well (default true)");
   c->add_option("--confirm", o.spot.confirm,
-                "s pointing must stay held after --hold before the event goes out, or it is dropped (default 0: none)")
+                "s pointing must stay held after --hold before the event goes out, or it is dropped (default 0: none; spot --model: "
+                "the model's)")
       ->check(CLI::Range(0.0, 10.0));
   c->add_option("--min-confidence", o.spot.min_confidence,
-                "events less sure than this (1 - exp(-margin) over the next class) are dropped (default 0)")
+                "events less sure than this (1 - exp(-margin) over the next class) are dropped (default 0; spot --model: the model's)")
       ->check(CLI::Range(0.0, 1.0));
   c->add_option("--min-straightness", o.spot.min_straightness,
                 "pointing: shoulder to hand over the arm's length, averaged over the hold, at least this (1: straight; 0: any; default 0.9)")
@@ -179,7 +180,11 @@ void add_gesture_command(CLI::App& app, GlobalOptions&, Action& run) {
                  "where the inputs have annotations), or a clip classifier (a file, or the built-in 'sim') run through the "
                  "live component's spotter (events listed and counted per hour)")
       ->check(CLI::ExistingFile | CLI::IsMember(builtin_model_names()));
-  sp->callback([o, &run] { run = [o] { return gesture_spot(*o); }; });
+  sp->callback([o, sp, &run] {
+    o->operating_point_given[0] = sp->count("--min-confidence") > 0;
+    o->operating_point_given[1] = sp->count("--confirm") > 0;
+    run = [o] { return gesture_spot(*o); };
+  });
 
   auto* sm = g->add_subcommand("sim", "Simulated pointing sessions (no outside data): train a classifier on some, spot "
                                      "gestures in the others' fused stream and score precision, recall, latency and target error");

@@ -61,6 +61,7 @@ struct GestureOptions {
   int quiet_sessions = 1;                                                  // ... sessions of each
   int train_quiet_sessions = kTrainQuietSessions;                          // ... to train against (hard negatives)
   SpotterOptions spot;
+  bool operating_point_given[2] = {false, false};  // --min-confidence, --confirm given (else a clip model's own)
   double gap = 0.0;
   double rest = 0.0;
 };

@@ -65,7 +65,11 @@ int gesture_sim(const GestureOptions& o) {
   const auto model = train_on_sim(o.train_sessions, o.seed, c, &clips,
                                   [&](int d, int t) { progress("simulating and fusing training sessions", d, t); }, o.spot,
                                   o.train_quiet_sessions, o.train_heights);
-  if (!o.out.empty()) model.save(o.out);
+  if (!o.out.empty()) {  // with the operating point it was measured at
+    auto saved = model;
+    saved.set_operating_point({o.spot.min_confidence, o.spot.confirm});
+    saved.save(o.out);
+  }
   const auto test = held_out_sessions(o.test_sessions, o.seed, [&](int d, int t) { progress("simulating and fusing test sessions", d, t); },
                                       o.test_noise_scale, o.test_height);
   const auto spotted = spot_sessions(model, test, o.spot);
@@ -149,6 +153,10 @@ int gesture_sim(const GestureOptions& o) {
                                                     model.pointing_correction().hand.z()}}}},
                                         {"spotting", to_json(r)},
                                         {"false_alarms", quiet_json},
+                                        {"operating_point", {{"min_confidence", o.spot.min_confidence},
+                                                             {"confirm_s", o.spot.confirm},
+                                                             {"recall", r.recall},
+                                                             {"false_per_hour", quiet.per_hour("point")}}},
                                         {"operating_curve", curve_json},
                                         {"spotted_within_15_cm", within(r.target_error_m)},
                                         {"whole_hold_reference", whole_json},

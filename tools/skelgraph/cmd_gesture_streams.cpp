@@ -87,6 +87,9 @@ int gesture_train_streams(const GestureOptions& o) {
 // makes the model's gestures).
 int gesture_spot_classifier(const GestureOptions& o) {
   const auto model = is_builtin_model(o.model) ? load_builtin_model(o.model) : Classifier::load(o.model);
+  SpotterOptions spot = o.spot;  // the model's operating point unless given
+  if (!o.operating_point_given[0]) spot.min_confidence = model.operating_point().min_confidence;
+  if (!o.operating_point_given[1]) spot.confirm = model.operating_point().confirm_s;
   const auto format = *playback::format_from_name(o.format);
   BadInputs bad;
   nlohmann::json files = nlohmann::json::array();
@@ -105,7 +108,7 @@ int gesture_spot_classifier(const GestureOptions& o) {
     const auto t0 = rec.frames.front().stamp_ns;
     for (std::size_t i = 0; i < rec.frames.size(); ++i) {
       const auto& s = rec.frames[i];
-      auto& sp = spotters.try_emplace({s.sensor_id, s.person_id}, model, o.spot).first->second;
+      auto& sp = spotters.try_emplace({s.sensor_id, s.person_id}, model, spot).first->second;
       for (const auto& e : sp.step(s, wrists.empty() ? nullptr : &wrists[i])) {
         ev.push_back({{"label", e.label}, {"person_id", e.person_id}, {"time_s", 1e-9 * static_cast<double>(e.end_ns - t0)},
                       {"confidence", e.confidence}});
@@ -120,7 +123,11 @@ int gesture_spot_classifier(const GestureOptions& o) {
   nlohmann::json per_hour = nlohmann::json::object();
   for (const auto& [label, n] : by_label) per_hour[label] = seconds > 0 ? static_cast<double>(n) * 3600.0 / seconds : 0.0;
   if (o.json) {
-    std::printf("%s\n", nlohmann::json{{"model", o.model}, {"seconds", seconds}, {"events_per_hour", per_hour}, {"files", files}}
+    std::printf("%s\n", nlohmann::json{{"model", o.model},
+                                        {"operating_point", {{"min_confidence", spot.min_confidence}, {"confirm_s", spot.confirm}}},
+                                        {"seconds", seconds},
+                                        {"events_per_hour", per_hour},
+                                        {"files", files}}
                              .dump(2)
                              .c_str());
   } else {

@@ -203,6 +203,7 @@ nlohmann::json Classifier::to_json() const {
             {"azimuth_out_deg", pointing_.azimuth_out},
             {"shoulder_offset_m", {pointing_.shoulder.x(), pointing_.shoulder.y(), pointing_.shoulder.z()}},
             {"hand_offset_m", {pointing_.hand.x(), pointing_.hand.y(), pointing_.hand.z()}}}},
+          {"operating_point", {{"min_confidence", operating_.min_confidence}, {"confirm_s", operating_.confirm_s}}},
           {"models", models}};
 }
 
@@ -245,6 +246,17 @@ Classifier Classifier::from_json(const nlohmann::json& j) {
         throw ModelError(std::string("classifier: 'pointing_correction.") + key + "' must be [out, up, forward] in metres");
       *out = Eigen::Vector3d(v[0].get<double>(), v[1].get<double>(), v[2].get<double>());
     }
+  }
+  if (j.contains("operating_point")) {
+    const auto& p = j["operating_point"];
+    const auto number = [&](const char* key, double hi) {
+      if (!p.is_object() || !p.contains(key) || !p[key].is_number() || p[key].get<double>() < 0 || p[key].get<double>() > hi)
+        throw ModelError(std::string("classifier: 'operating_point.") + key + "' must be a number from 0 to " +
+                         (hi == 1.0 ? "1" : "10"));
+      return p[key].get<double>();
+    };
+    c.operating_.min_confidence = number("min_confidence", 1.0);
+    c.operating_.confirm_s = number("confirm_s", 10.0);
   }
   const int K = static_cast<int>(c.labels_.size());
   if (c.garbage_ < -1 || c.garbage_ >= K) throw ModelError("classifier: 'garbage' is not a label index or -1");

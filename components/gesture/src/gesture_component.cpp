@@ -63,8 +63,12 @@ runtime::ComponentInfo GestureComponent::describe() {
       .add_double("min_raise_deg", 35.0, "an extended arm counts as pointing only raised this far from hanging straight down", 0.0, 180.0)
       .add_double("max_target_m", 4.0, "pointing must land on a surface within this of the shoulder (0: any ray)", 0.0, 100.0)
       .add_bool("other_arm_free", true, "pointing needs the other arm not held out as well (carrying, a stretch)")
-      .add_double("confirm_s", 0.0, "pointing must stay held this long after hold_s or it is dropped (a confirmation)", 0.0, 10.0)
-      .add_double("min_confidence", 0.0, "events less sure than this (1 - exp(-margin) over the next class) are dropped", 0.0, 1.0)
+      .add_double("confirm_s", -1.0,
+                  "pointing must stay held this long after hold_s or it is dropped (a confirmation; -1: the model's operating point)",
+                  -1.0, 10.0)
+      .add_double("min_confidence", -1.0,
+                  "events less sure than this (1 - exp(-margin) over the next class) are dropped (-1: the model's operating point)",
+                  -1.0, 1.0)
       .add_double("min_straightness", 0.90, "pointing: shoulder to hand over the arm's length, averaged over the hold, at least this (0: any)", 0.0, 1.0)
       .add_double("max_lean_m", 0.07, "pointing: the neck at most this far off the torso horizontally over the hold, m (0: any)", 0.0, 1.0)
       .add_double("person_timeout_ms", 2000.0, "a person not seen this long is forgotten", 10.0, 60000.0);
@@ -107,6 +111,9 @@ GestureComponent::GestureComponent(runtime::Context& ctx, const runtime::Params&
             const auto it = people_.find({last.sensor_id().to_string(), last.person_id()});
             if (it != people_.end()) forget(it);
           }) {
+  // The operating point the model was given, unless the parameters set one.
+  if (options_.min_confidence < 0) options_.min_confidence = classifier_.operating_point().min_confidence;
+  if (options_.confirm < 0) options_.confirm = classifier_.operating_point().confirm_s;
   const auto& labels = classifier_.labels();
   if (std::find(labels.begin(), labels.end(), options_.point_label) == labels.end())
     spdlog::warn("{}: the classifier has no class '{}': no pointing rays will be given", ctx_.name(), options_.point_label);
@@ -199,8 +206,13 @@ std::string GestureComponent::summary() const {
 }
 
 nlohmann::json GestureComponent::details() const {
-  return {{"skeletons", skeletons_}, {"events", events_},      {"by_label", events_by_label_},
-          {"people", people_.size()},  {"people_seen", seen_},   {"people_left", left_}};
+  return {{"skeletons", skeletons_},
+          {"events", events_},
+          {"by_label", events_by_label_},
+          {"people", people_.size()},
+          {"people_seen", seen_},
+          {"people_left", left_},
+          {"operating_point", {{"min_confidence", options_.min_confidence}, {"confirm_s", options_.confirm}}}};
 }
 
 }  // namespace skelgraph::gesture

@@ -96,9 +96,18 @@ class Classifier {
   bool trimmed() const { return trimmed_; }
   const PointingCorrection& pointing_correction() const { return pointing_; }
   void set_pointing_correction(const PointingCorrection& p) { pointing_ = p; }
+  // Where the model's events are cut, chosen for it (`gesture sim --min-confidence --confirm --out`): a spotter
+  // with this model uses it unless told otherwise (SpotterOptions::min_confidence, confirm). Default 0, 0.
+  struct OperatingPoint {
+    double min_confidence = 0.0;  // events less sure than this are dropped, 0-1
+    double confirm_s = 0.0;       // pointing held this long beyond the hold, 0-10 s
+  };
+  const OperatingPoint& operating_point() const { return operating_; }
+  void set_operating_point(const OperatingPoint& p) { operating_ = p; }
 
   // "skelgraph-gesture-classifier" version 1: labels, garbage, threshold, feature set, hands, trimmed,
   // pointing_correction {elevation_deg, azimuth_out_deg, shoulder_offset_m?, hand_offset_m?} (optional, default 0),
+  // operating_point {min_confidence, confirm_s} (optional, default 0),
   // models (each a skelgraph-hmm with its class index and the action it was trained on).
   nlohmann::json to_json() const;
   static Classifier from_json(const nlohmann::json& j);  // throws ModelError naming the field
@@ -114,6 +123,7 @@ class Classifier {
   Hands hands_ = Hands::Canonical;
   bool trimmed_ = true;
   PointingCorrection pointing_;
+  OperatingPoint operating_;
   double threshold_ = -1e300;
   FeatureSet features_ = FeatureSet::Thesis8;
 };
