@@ -173,6 +173,17 @@ json_check "$WORK/stream_spot.json" 'len(d["files"]) == 2 and all(len(f["events"
 "$S" gesture spot --model "$WORK/model.json" --format msrc12 "$MS"/P1_1_1_p21.csv --json >"$WORK/clip_model.json" \
   2>"$WORK/clip_model.err" || fail "a clip classifier given to spot --model: $(cat "$WORK/clip_model.err")"
 json_check "$WORK/clip_model.json" 'len(d["files"]) == 1 and "events_per_hour" in d'
+# Ctrl-C stops offline work at once (exit 130), with nothing half-printed on stdout.
+"$S" gesture sim --test-sessions 30 --json >"$WORK/int.json" 2>"$WORK/int.err" &
+sim_pid=$!
+wait_for_match "$WORK/int.err" "simulating" 60 || fail "gesture sim shows no progress: $(cat "$WORK/int.err")"
+kill -INT "$sim_pid"
+rc=0
+wait "$sim_pid" || rc=$?
+[ "$rc" = 130 ] || fail "gesture sim after SIGINT: exit $rc, expected 130: $(tail -2 "$WORK/int.err")"
+[ ! -s "$WORK/int.json" ] || fail "an interrupted gesture sim printed: $(head -c 300 "$WORK/int.json")"
+grep -q "interrupted (SIGINT)" "$WORK/int.err" || fail "no word of the interruption: $(tail -2 "$WORK/int.err")"
+ok "Ctrl-C ends offline work at once: exit 130, nothing on stdout"
 # The operating point travels with a model: written by gesture sim --out, used by spot unless given.
 "$S" gesture sim --train-sessions 4 --train-quiet-sessions 1 --test-sessions 1 --quiet-sessions 1 --min-confidence 0.3 \
   --confirm 0.25 --out "$WORK/op.json" --json >"$WORK/op_sim.json" 2>"$WORK/op_sim.err" || fail "sim --out: $(cat "$WORK/op_sim.err")"

@@ -95,10 +95,24 @@ extern const CLI::Validator kPositive;
 // Adds --domain/--profile/--interface to a subcommand that talks DDS.
 void add_dds_options(CLI::App& cmd, GlobalOptions& g);
 
-// SIGINT/SIGTERM are blocked in every thread from the start; these wait for them.
+// SIGINT/SIGTERM are blocked in every thread from the start (DDS threads never
+// see them) and taken by one watcher thread. Where a command has said it stops
+// gracefully (a SignalHandling in scope: a running graph, `topic echo`), a
+// signal is handed to wait_for_signal; anywhere else (offline work: eval,
+// gesture cv, the demo's report) it ends the process at once, exit 128 + the
+// signal, as Ctrl-C does to any command-line tool. A second signal always does.
 void block_signals();
-// True if a signal arrived within `timeout`.
+// True if a signal arrived within `timeout` (only while a SignalHandling is in scope).
 bool wait_for_signal(std::chrono::milliseconds timeout);
+// Whether a signal has arrived since the process started (handled or not yet).
+bool interrupted();
+class SignalHandling {
+ public:
+  SignalHandling();
+  ~SignalHandling();
+  SignalHandling(const SignalHandling&) = delete;
+  SignalHandling& operator=(const SignalHandling&) = delete;
+};
 
 // Each adds a subcommand; when the user picks it, `run` is set to its action.
 using Action = std::function<int()>;

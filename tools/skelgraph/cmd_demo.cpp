@@ -97,6 +97,10 @@ int run_demo(const DemoOptions& o, GlobalOptions& g) {
     file = recorded_file(graph);
     out = report;
   });
+  if (interrupted()) {  // the live graph was stopped by a signal: no report of half a session
+    std::fprintf(stderr, "[demo] interrupted: the live graph stopped, no report written\n");
+    return 130;
+  }
   if (!o.json) print_live(out["seen"]);
   if (rc != 0) {
     std::fprintf(stderr, "skelgraph demo: a component of the live graph ended in ERROR (see above)\n");

@@ -54,6 +54,7 @@ runtime::ReaderPlan plan_for(const std::string& topic, ToolSession& s, Ms timeou
 }
 
 int list(const runtime::DdsConfig& config, double wait_s, bool json, bool all) {
+  const SignalHandling stops_gracefully;
   ToolSession s("list", config);
   wait_for_signal(seconds(wait_s));
   auto topics = s.observer.topics();
@@ -88,6 +89,7 @@ int list(const runtime::DdsConfig& config, double wait_s, bool json, bool all) {
 }
 
 int echo(const runtime::DdsConfig& config, const std::string& topic, std::size_t count, double timeout_s, bool json) {
+  const SignalHandling stops_gracefully;
   ToolSession s("echo", config);
   const auto plan = plan_for(topic, s, seconds(timeout_s));
   const auto* info = msg::find_message(plan.type_name);
@@ -142,6 +144,7 @@ int echo(const runtime::DdsConfig& config, const std::string& topic, std::size_t
 
 int hz(const runtime::DdsConfig& config, const std::string& topic, double window_s, double timeout_s, bool json,
        double duration_s) {
+  const SignalHandling stops_gracefully;
   ToolSession s("hz", config);
   const auto plan = plan_for(topic, s, seconds(timeout_s));
   std::mutex mutex;

@@ -1,10 +1,16 @@
 // skelgraph: the command-line front end (launch, topic, sync, demo, components).
 
+#include <pthread.h>
+
+#include <algorithm>
+#include <condition_variable>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
+#include <mutex>
 #include <string>
+#include <thread>
 
 #include <unistd.h>
 
@@ -116,22 +122,74 @@ void add_dds_options(CLI::App& cmd, GlobalOptions& g) {
                  "to test clock-offset estimation on one machine");
 }
 
-void block_signals() {
+namespace {
+struct SignalState {
+  std::mutex m;
+  std::condition_variable cv;
+  int handlers = 0;  // SignalHandling objects alive
+  int pending = 0;   // handed over, not yet taken by wait_for_signal
+  bool any = false;
+};
+SignalState& signal_state() {
+  static SignalState s;
+  return s;
+}
+sigset_t stop_signals() {
   sigset_t set;
   sigemptyset(&set);
   sigaddset(&set, SIGINT);
   sigaddset(&set, SIGTERM);
+  return set;
+}
+}  // namespace
+
+void block_signals() {
+  const sigset_t set = stop_signals();
   pthread_sigmask(SIG_BLOCK, &set, nullptr);
+  std::thread([] {
+    const sigset_t watched = stop_signals();
+    auto& st = signal_state();
+    for (;;) {
+      int sig = 0;
+      if (sigwait(&watched, &sig) != 0) continue;
+      std::lock_guard<std::mutex> lock(st.m);
+      const bool again = st.any;  // a second Ctrl-C while the first is being handled: stop now
+      st.any = true;
+      if (st.handlers == 0 || again) {
+        std::fprintf(stderr, "\ninterrupted (%s)\n", sig == SIGINT ? "SIGINT" : "SIGTERM");
+        std::fflush(stderr);
+        std::_Exit(128 + sig);
+      }
+      ++st.pending;
+      st.cv.notify_all();
+    }
+  }).detach();
 }
 
 bool wait_for_signal(std::chrono::milliseconds timeout) {
-  sigset_t set;
-  sigemptyset(&set);
-  sigaddset(&set, SIGINT);
-  sigaddset(&set, SIGTERM);
-  const auto ms = timeout.count() < 0 ? 0 : timeout.count();
-  timespec ts{static_cast<time_t>(ms / 1000), static_cast<long>((ms % 1000) * 1000000)};
-  return sigtimedwait(&set, nullptr, &ts) > 0;
+  auto& st = signal_state();
+  std::unique_lock<std::mutex> lock(st.m);
+  if (!st.cv.wait_for(lock, std::max(timeout, std::chrono::milliseconds(0)), [&] { return st.pending > 0; })) return false;
+  --st.pending;
+  return true;
+}
+
+bool interrupted() {
+  auto& st = signal_state();
+  std::lock_guard<std::mutex> lock(st.m);
+  return st.any;
+}
+
+SignalHandling::SignalHandling() {
+  auto& st = signal_state();
+  std::lock_guard<std::mutex> lock(st.m);
+  ++st.handlers;
+}
+
+SignalHandling::~SignalHandling() {
+  auto& st = signal_state();
+  std::lock_guard<std::mutex> lock(st.m);
+  --st.handlers;
 }
 
 namespace {

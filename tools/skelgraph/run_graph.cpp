@@ -88,6 +88,7 @@ int run_graph(const runtime::ComponentRegistry& registry, const runtime::DdsConf
                          ? t0 + std::chrono::duration_cast<clock::duration>(
                                     std::chrono::duration<double>(options.status_every_s))
                          : clock::time_point::max();
+  const SignalHandling stops_gracefully;  // a signal ends the loop below; the graph is stopped and reported
   bool signalled = false;
   auto next_heal = t0;
   while (!signalled) {
