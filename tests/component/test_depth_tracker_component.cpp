@@ -142,6 +142,7 @@ Run run_component(const Cell& cell, bool merge, bool publish_poses) {
   graph.start();
   const auto& tracker_ctx = graph.context("tracker");
   EXPECT_TRUE(depth.wait_for_matched(1, 10s));
+  EXPECT_TRUE(test::wait_input_matched(tracker_ctx, topics::kDepth.name));  // best effort: the first image would be lost
   EXPECT_TRUE(raw_sub.wait_for_matched(1, 10s));
   EXPECT_TRUE(frame_sub.wait_for_matched(1, 10s));
   if (publish_poses) {

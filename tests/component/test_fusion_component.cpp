@@ -107,6 +107,8 @@ TEST(FusionComponent, FusesCalibratedSensorsOnTicksAndGoesOnWhenOneFallsSilent) 
   ASSERT_TRUE(poses.wait_for_acks(10s));
   ASSERT_TRUE(raw.wait_for_matched(1, 10s));
   ASSERT_TRUE(fused_sub.wait_for_matched(1, 10s));
+  ASSERT_TRUE(test::wait_input_matched(graph.context("fusion"), topics::kSkeletonRaw.name));  // best effort
+  ASSERT_TRUE(test::wait_input_matched(graph.context("fusion"), topics::kSensorFrame.name));
 
   std::uint64_t frame = 0, tick = 0;
   // One frame of each of `sensors` seen now, then a TICK, until the fused

@@ -63,6 +63,7 @@ TEST(RecorderComponent, RecordsASyncSessionAndAcknowledgesEveryTick) {
   ASSERT_TRUE(sync.wait_for_matched(1, 10s));
   ASSERT_TRUE(raw.wait_for_matched(1, 10s));
   ASSERT_TRUE(ack_sub.wait_for_matched(1, 10s));
+  ASSERT_TRUE(test::wait_input_matched(graph.context("recorder"), topics::kSkeletonRaw.name));  // best effort
 
   // Before the session: a sensor pose (kept for late joiners, so it goes into the file).
   skeleton::SensorPose pose;

@@ -116,6 +116,8 @@ TEST(ViewerComponent, PagesSeeTheCellAndDriveItsPlayers) {
   ASSERT_TRUE(gestures.wait_for_matched(1, 10s));
   ASSERT_TRUE(control_sub.wait_for_matched(1, 10s));
   const auto& viewer_ctx = graph.context("viewer");
+  ASSERT_TRUE(test::wait_input_matched(viewer_ctx, topics::kSkeletonRaw.name));  // best effort: a first sample would be lost
+  ASSERT_TRUE(test::wait_input_matched(viewer_ctx, topics::kSkeletonFused.name));
 
   skeleton::SensorPose pose;
   pose.sensor_id = "sensor1";

@@ -43,6 +43,16 @@ inline bool wait_endpoint_count(const runtime::Context& ctx, Endpoint which, con
   }
   return true;
 }
+// Until the component's reader of `topic` has matched n writers on its own
+// side. A writer that sees the reader (wait_for_matched) may still be unknown
+// to it, and a best-effort sample from an unknown writer is dropped for good.
+inline bool wait_input_matched(const runtime::Context& ctx, const std::string& topic, std::size_t n = 1,
+                               std::chrono::milliseconds timeout = std::chrono::seconds(10)) {
+  for (const auto& c : ctx.counters()) {
+    if (!c->is_output && c->topic == topic) return c->wait_matched(n, timeout);
+  }
+  return false;
+}
 inline bool wait_input_count(const runtime::Context& ctx, const std::string& topic, std::uint64_t n,
                              std::chrono::milliseconds timeout = std::chrono::seconds(10)) {
   return wait_endpoint_count(ctx, Endpoint::Input, topic, n, timeout);
