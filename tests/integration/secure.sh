@@ -120,8 +120,9 @@ if grep -q "^session_" "$WORK/files.txt"; then fail "a recorder obeyed a strange
 "$SKELGRAPH" bag info "$WORK/merged.mcap" --json >"$WORK/info.json"
 # Every tick acked by every host; a recorder that launch started over within the session (a stuck
 # authentication, docs/security.md; it goes on in a second file) misses at most the ticks of its
-# restart (2 s).
+# restart: 2 s of 33 ms ticks (about 1 s on an idle machine; 1.2 s seen beside two busy loops).
 ticks=$(json_get "$WORK/stop.json" 'd["tick"]')
+restart_ticks=$((2000 / 33))
 for h in fusion sensor1 sensor2; do
   files=$(ls "$WORK/$h"/recordings/secure_*.mcap | wc -l)
   acked=$(json_get "$WORK/info.json" 'd["ticks_acked_by_host"].get("'"$h"'", 0)')
@@ -129,7 +130,7 @@ for h in fusion sensor1 sensor2; do
     [ "$acked" -eq "$ticks" ] || fail "$h acked $acked of $ticks ticks"
   else
     grep -q "restarting it with a new DDS participant" "$WORK/$h.err" || fail "$h: $files files but no restart reported"
-    [ "$acked" -ge $((ticks - 30)) ] || fail "$h acked $acked of $ticks ticks across its restart"
+    [ "$acked" -ge $((ticks - restart_ticks)) ] || fail "$h acked $acked of $ticks ticks across its restart"
     echo "  $h: recorder started over within the session ($files files), $acked of $ticks ticks acked"
   fi
 done
