@@ -40,12 +40,15 @@ browser_check() {
   [ "$(curl -s -o /dev/null -w '%{http_code}' "${URL}three/three.module.js")" = 200 ] || fail "three.js is not served"
   [ "$(curl -s --path-as-is -o /dev/null -w '%{http_code}' "${URL}../../../etc/passwd")" = 404 ] || fail "a path outside the page was served"
 
-  # A pointing gesture twice a second (the page draws its ray and target).
-  "$PUBLISH_GESTURE" 30 2>/dev/null &
+  # A pointing gesture twice a second (the page draws its ray and target), until the check is done:
+  # a busy machine's browser may take longer than any fixed duration (a loaded run outlasted 30 s).
+  "$PUBLISH_GESTURE" 300 2>/dev/null &
+  local gesture_pid=$!
   # The page in a real browser.
   local shot=$SHOT
   [ "$sensors" = 2 ] || shot=${SHOT%.png}-$sensors-sensors.png
   CHROMIUM="$CHROMIUM" node "$BROWSER_DIR/check_viewer.mjs" "$URL" "$shot" 5 >"$WORK/$tag-page.json" || fail "the browser check failed"
+  kill "$gesture_pid" 2>/dev/null || true
   python3 - "$WORK" "$tag" "$sensors" <<'PY' || fail "what the page drew does not match what was published (above)"
 import json, sys
 work, tag, sensors = sys.argv[1], sys.argv[2], int(sys.argv[3])
