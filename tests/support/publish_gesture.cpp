@@ -1,7 +1,11 @@
 // publish_gesture: a pointing GestureEvent with a ray and a floor target,
 // twice a second for N seconds, on skelgraph/gesture/event (for the viewer's
-// browser test: the page must draw the ray and the target and name them).
-//   publish_gesture [SECONDS] [LABEL]   (default 10, "pointing")
+// browser test: the page must draw the ray and the target and name them; for
+// the LAN test: events that must reach every host's recorder).
+//   publish_gesture [SECONDS] [LABEL] [READERS]   (default 10, "pointing", 1)
+// Starts publishing once READERS readers have matched. On the "loopback"
+// profile unless SKELGRAPH_PROFILE names another (the LAN test's hosts, inside
+// their network namespaces).
 // Every event: label LABEL, person 7, right arm, ray from (0, 1.4, 0)
 // towards (1, -1, 0)/sqrt(2), target (1.4, 0, 0) named "floor".
 #include <chrono>
@@ -16,8 +20,9 @@
 int main(int argc, char** argv) {
   using namespace skelgraph;
   const double seconds = argc > 1 ? std::atof(argv[1]) : 10.0;
+  const int readers = argc > 3 ? std::atoi(argv[3]) : 1;
   auto config = runtime::DdsConfig::from_env();
-  config.profile = "loopback";  // tests only: 127.0.0.1 and shared memory
+  if (std::getenv("SKELGRAPH_PROFILE") == nullptr) config.profile = "loopback";  // 127.0.0.1 and shared memory
   runtime::Context ctx("publish_gesture", config);
   runtime::Publisher<msg::GestureEvent> pub(ctx, runtime::topics::kGestureEvent);
   msg::GestureEvent e;
@@ -35,15 +40,18 @@ int main(int argc, char** argv) {
   e.target().x(1.4);
   e.target_name("floor");
   // Events are not kept for late joiners (volatile): first a reader to hear them.
-  if (!pub.wait_for_matched(1, std::chrono::seconds(20))) {
-    std::fprintf(stderr, "publish_gesture: no reader of skelgraph/gesture/event within 20 s\n");
+  if (!pub.wait_for_matched(static_cast<std::size_t>(readers), std::chrono::seconds(20))) {
+    std::fprintf(stderr, "publish_gesture: not %d reader(s) of skelgraph/gesture/event within 20 s\n", readers);
     return 1;
   }
   const int count = static_cast<int>(seconds * 2);
   for (int i = 0; i < count; ++i) {
     e.start_stamp_ns(runtime::system_clock()->now_ns() - 500'000'000);
     e.end_stamp_ns(runtime::system_clock()->now_ns());
-    pub.publish(e);
+    if (!pub.publish(e)) {
+      std::fprintf(stderr, "publish_gesture: event %d not published\n", i + 1);
+      return 1;
+    }
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
   }
   std::fprintf(stderr, "publish_gesture: published %d events\n", count);
