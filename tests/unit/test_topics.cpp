@@ -28,6 +28,7 @@ TEST(Topics, AReadingToolsPlanKeepsTheTypeAndKeyAndDeepensTheHistory) {
   const auto sync = runtime::reader_plan(*runtime::find_topic(runtime::topics::kSync.name), 256, 256);
   EXPECT_FALSE(sync.keyed);
   EXPECT_EQ(sync.qos.depth, 256);  // keep-all becomes a bounded history
+  EXPECT_EQ(runtime::reader_plan(*runtime::find_topic(runtime::topics::kSync.name), 256, 0).qos.depth, 0);  // or stays keep-all
 
   runtime::TopicInfo deep{"x", msg::MessageTraits<msg::SyncCommand>::name, runtime::topics::kSync.qos};
   deep.qos.depth = 500;

@@ -57,7 +57,11 @@ Recorder::Recorder(runtime::Context& ctx, const runtime::Params& params)
   for (const auto& name : topics_) {
     const auto* t = runtime::find_topic(name);
     if (t == nullptr) throw std::invalid_argument("recorder: '" + name + "' is not a skelgraph topic");
-    const auto plan = runtime::reader_plan(*t, 256, 256);  // keep up with bursts; recording never blocks writers
+    // A deeper history for bursts; what its writers keep all of (sync ticks, acks,
+    // gesture events) the recorder keeps all of too: a recorder starved of CPU
+    // for seconds holds the writers' samples instead of losing them (a loaded
+    // LAN run lost a fifth of the acks from a 256-deep history).
+    const auto plan = runtime::reader_plan(*t, 256, 0);
     const bool keyed = plan.keyed;
     const runtime::TopicInfo info = *t;
     subs_.push_back(std::make_unique<runtime::RawSubscription>(

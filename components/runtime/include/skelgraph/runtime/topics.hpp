@@ -97,8 +97,11 @@ const TopicInfo* find_topic(const std::string& name);
 
 // How a tool that only reads (the recorder, `topic echo`, `topic hz`)
 // subscribes to a topic of the table: its type, whether it is keyed, and its
-// QoS with a deeper history, so that bursts are kept and writers are never
-// blocked: keep-all becomes `keep_all_depth`, a shorter history `min_depth`.
+// QoS with a deeper history, so that bursts are kept: a shorter history
+// becomes `min_depth`; keep-all becomes `keep_all_depth` (writers never wait
+// for this reader, which loses the oldest if it falls that far behind) or,
+// with 0, stays keep-all (nothing lost; a writer waits once this reader holds
+// QosPreset::kKeepAllSamples of an instance).
 struct ReaderPlan {
   std::string type_name;
   bool keyed = false;
