@@ -287,6 +287,26 @@ TEST(SafetyRun, TheJudgeCatchesASlowMonitor) {
   EXPECT_GT(skelgraph::eval::quantile(r.time_to_stop_ms, 1.0), 100.0);
 }
 
+
+// A perfect tracker (the true people, late by the trackers' delay, no
+// uncertainty) is never too close and stops the arm needlessly less often than
+// the fused skeletons with their uncertainty do; its stops with the release
+// hold taken away are only the latencies' (README: 1 % over the hour).
+TEST(SafetyRun, APerfectTrackerSetsTheFloorOfNeedlessStops) {
+  auto o = robot_cell(2);
+  const auto fused = skelgraph::eval::run_safety(o);
+  o.perfect_tracker = true;
+  const auto perfect = skelgraph::eval::run_safety(o);
+  EXPECT_EQ(perfect.missed_steps, 0u);
+  EXPECT_GT(perfect.intrusions, 0u);
+  EXPECT_LT(perfect.unnecessary_steps, fused.unnecessary_steps);
+  ASSERT_FALSE(perfect.reaction_ms.empty());
+  EXPECT_GT(skelgraph::eval::quantile(perfect.reaction_ms, 0.5), 60.0);  // the trackers' delay is kept
+  o.release_s = 0.0;
+  const auto no_hold = skelgraph::eval::run_safety(o);
+  EXPECT_LT(no_hold.unnecessary_steps, perfect.unnecessary_steps);
+  EXPECT_LT(no_hold.share_pct(no_hold.unnecessary_steps), 5.0);
+}
 // Every sensor falls silent from 8 s on: the monitor stops the arm (the
 // people data grows old, the sensors are lost) and keeps it stopped.
 TEST(SafetyRun, EverySensorSilentStopsTheArm) {

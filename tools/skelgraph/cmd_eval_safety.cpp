@@ -29,6 +29,7 @@ struct SafetyOptions {
   double release_ms = 500.0;
   double uncertainty_scale = 1.0;
   bool no_arm_hides = false;
+  bool perfect_tracker = false;
   bool follow = false;
   std::vector<std::string> dropouts;  // SENSOR,EVERY_S,FOR_S
   int min_sensors = 2;  // robot_cell.yaml's: with three of four sensors silent at once, 1 let the arm move too close
@@ -89,6 +90,7 @@ int eval_safety(const SafetyOptions& o) {
       so.release_s = o.release_ms * 1e-3;
       so.uncertainty_scale = o.uncertainty_scale;
       so.arm_hides = !o.no_arm_hides;
+      so.perfect_tracker = o.perfect_tracker;
       so.min_sensors = o.min_sensors;
       std::vector<std::string> sensors;
       for (const auto& sc : so.sim.sensors) sensors.push_back(sc.id);
@@ -222,6 +224,9 @@ void add_eval_safety_command(CLI::App& eval, Action& run) {
                 "a sensor falling silent: SENSOR,EVERY_S,FOR_S (e.g. sensor1,20,5: 5 s in every 20 s); repeatable");
   c->add_option("--min-sensors", o->min_sensors, "fewer live sensors than this: protective stop (the separation component's min_sensors; default 2, as robot_cell.yaml)")
       ->check(CLI::Range(0, 64));
+  c->add_flag("--perfect-tracker", o->perfect_tracker,
+              "the monitor sees the true people (as they were the capture latency ago, no uncertainty): "
+              "the floor the formula, the latencies and the release hold leave");
   c->add_flag("--follow", o->follow, "the arm follows the worker's right hand instead of its task (robot/follow.hpp)");
   c->add_option("--standoff-m", o->standoff_m, "follow: the tool keeps this far from the hand, on the robot's side")
       ->check(CLI::Range(0.0, 3.0));

@@ -120,6 +120,11 @@ SafetyRunResult run_safety(const SafetyRunOptions& o) {
     }
     if (now + 1e-12 >= next_fuse) {
       people = fuser.fuse(now_ns);
+      if (o.perfect_tracker) {
+        const double captured = now - static_cast<double>(o.capture_latency_ns) * 1e-9 - o.hop_s;
+        people = captured >= 0 ? sim.truth_at(captured) : std::vector<skeleton::Skeleton>{};
+        for (auto& p : people) p.capture_newest_ns = std::llround(captured * 1e9);
+      }
       next_fuse += o.fuse_period_s;
     }
 

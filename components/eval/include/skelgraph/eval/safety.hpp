@@ -50,6 +50,11 @@ struct SafetyRunOptions {
   robot::SeparationParams params;
   double release_s = 0.5;
   double uncertainty_scale = 1.0;   // Z_d: the fused joints' 95 % radius times this (0: left out, to see what it costs)
+  // A perfect tracker: the monitor sees the true people as they were the
+  // trackers' capture latency (plus the hop) ago, at the fusion rate, with no
+  // uncertainty. What is left is the floor the formula, the latencies and the
+  // release hold set, whatever the sensors.
+  bool perfect_tracker = false;
   bool arm_hides = true;            // the arm's links hide people from the sensors behind it (as a real arm does)
   double decision_rate_hz = 100.0;  // decisions and arm steps per second
   double command_latency_s = 0.01;  // from a decision to the arm acting on it (and in the reaction time)
