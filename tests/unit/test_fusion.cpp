@@ -625,6 +625,42 @@ TEST(Fusion, KalmanLeavesATrackersFrozenGhostBehind) {
   EXPECT_GT(f.stats().ghost_views, 30u);
 }
 
+// The same ghost where no other sensor sees the person: person 2, seen by
+// sensor 2 only, walks off at 2 s and sensor 2 repeats its last skeleton;
+// sensor 1 sees only person 1 (live, elsewhere). The ghost says where person
+// 2 was, not where they are: after the filter's short coast their fused
+// joints are unplaced (confidence 0, so a robot's monitor stops for a person
+// fusion cannot place), not held at the ghost as if seen.
+TEST(Fusion, KalmanDoesNotPlaceAPersonOnlyAFrozenGhostShows) {
+  auto f = make(fusion::Method::Kalman);
+  std::mt19937 rng(5);
+  std::normal_distribution<double> noise(0.0, 0.004);
+  const auto noisy = [&](skeleton::Skeleton s) {
+    for (auto& j : s.joints) j.position += Vector3d(noise(rng), noise(rng), noise(rng));
+    return s;
+  };
+  skeleton::Skeleton frozen;
+  std::size_t placed_before = 0, unplaced_after = 0, after = 0;
+  for (int k = 0; k < 120; ++k) {
+    const std::int64_t t = k * 33 * kMs;
+    f.add(in_sensor(noisy(person("s1", 1, {-1.5, 1, 0})), kS1), t);
+    if (k <= 60) frozen = noisy(person("s2", 2, {1.0, 1, 0}));  // from 2 s on, a ghost of person 2
+    f.add(in_sensor(frozen, kS2), t);
+    const auto out = f.fuse(t + kMs);
+    for (const auto& p : out) {
+      if ((p[JointId::Torso].position - Vector3d(1.0, 1.2, 0)).norm() > 0.5 && p[JointId::Torso].confidence > 0) continue;
+      if (k < 60) placed_before += skeleton::centre_of(p).has_value();
+      if (k >= 80) {  // 4 frames to freeze, the coast, a margin
+        ++after;
+        unplaced_after += !skeleton::centre_of(p).has_value();
+      }
+    }
+  }
+  EXPECT_GT(placed_before, 50u);  // seen, person 2 is placed
+  EXPECT_GT(after, 30u);          // the ghost keeps the person known...
+  EXPECT_EQ(unplaced_after, after);  // ... but not placed
+}
+
 TEST(JointFilter, ConvergesOnAMovingPointAndEstimatesItsVelocity) {
   fusion::JointFilter kf;
   kf.reset({0, 0, 0}, 0.05, 0);

@@ -84,7 +84,9 @@ struct Stream {
   std::int64_t first_ns = 0;  // its first sample: a tracker's fresh skeleton is still settling
   double arm_confidence = 1.0;  // mean confidence of its arm joints, lately (kArmMemory)
   int still = 0;                // samples in a row whose shape did not change (kFrozenM)
+  int parked = 0;               // ... nor its place (the torso moved under kFrozenM)
   bool frozen() const { return still >= kFrozenFrames; }
+  bool parked_ghost() const { return parked >= kFrozenFrames; }
   std::deque<Sample> samples;
   std::optional<std::uint32_t> track;
 };
@@ -768,6 +770,19 @@ struct Fuser::Impl {
     }
     auto by_track = associate(views, t);
     for (auto& v : frozen) join_if_in_place(v, by_track);
+    // A person whom only frozen skeletons standing in one place put there
+    // (every live view lost them): the ghost says where they were, not where
+    // they are (they walked on). Their filters coast on, the uncertainty
+    // growing, and after kCoastNs their joints are unplaced (confidence 0): a
+    // robot's monitor stops for a person fusion cannot place rather than
+    // trust the ghost. (A tracker's live person is never that still: depth
+    // noise moves every joint.)
+    for (auto& [id, vs] : by_track) {
+      if (!frozen.empty() && !vs.empty() &&
+          std::all_of(vs.begin(), vs.end(), [](const View* v) { return v->stream->parked_ghost(); })) {
+        for (View* v : vs) v->occluded = true;
+      }
+    }
     std::vector<skeleton::Skeleton> out;
     ++frame_number;
     for (auto& [id, vs] : by_track) {
@@ -877,9 +892,13 @@ void Fuser::add(const skeleton::Skeleton& raw, std::int64_t t_ns) {
   }
   st.arm_confidence = kArmMemory * st.arm_confidence + (1 - kArmMemory) * arms / 6;
   if (!st.samples.empty() && pos == st.samples.end() && t_ns - st.samples.back().t <= impl_->opt.max_age_ns) {
-    st.still = shape_change(st.samples.back().world, s.world) < kFrozenM ? st.still + 1 : 0;
+    const auto& prev = st.samples.back().world;
+    st.still = shape_change(prev, s.world) < kFrozenM ? st.still + 1 : 0;
+    const bool stayed = (prev[JointId::Torso].position - s.world[JointId::Torso].position).norm() < kFrozenM;
+    st.parked = st.still > 0 && stayed ? st.parked + 1 : 0;
   } else if (pos == st.samples.end()) {
     st.still = 0;
+    st.parked = 0;
   }
   st.samples.insert(pos, std::move(s));
   while (st.samples.size() > kHistory) st.samples.pop_front();
