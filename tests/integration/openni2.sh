@@ -68,23 +68,23 @@ ok "played back $frames frames fast and in $(json_get "$WORK/play1.json" 'round(
 "$SKELGRAPH" run openni2 --name player1 -p uri="$WORK/mended.oni" -p paused=true --duration 40 --json \
   >"$WORK/step.json" 2>"$WORK/step.err" &
 player=$!
-"$SKELGRAPH" player state --target player1 --json --timeout 10 >"$WORK/st0.json" || fail "player state: $(cat "$WORK/step.err")"
+"$SKELGRAPH" player state --target player1 --json --timeout 30 >"$WORK/st0.json" || fail "player state: $(cat "$WORK/step.err")"
 json_check "$WORK/st0.json" 'd[0]["paused"] and d[0]["frames"] == 0 and d[0]["frame_count"] == '"$frames"
 "$SKELGRAPH" topic echo skelgraph/depth --count 3 --json --timeout 15 >"$WORK/steps.jsonl" 2>"$WORK/steps.err" &
 echo_pid=$!
 wait_for_match "$WORK/steps.err" "echo: matched" 10 || fail "the echo found no depth writer: $(cat "$WORK/steps.err")"
-"$SKELGRAPH" player step --frames 3 --target player1 --json >"$WORK/st1.json" || fail "step"
+"$SKELGRAPH" player step --timeout 30 --frames 3 --target player1 --json >"$WORK/st1.json" || fail "step"
 json_check "$WORK/st1.json" 'd[0]["paused"] and d[0]["frames"] == 3 and d[0]["error"] == ""'
 wait "$echo_pid" || fail "echo of the stepped frames: $(cat "$WORK/steps.err")"
 python3 -c 'import json, sys; n = [json.loads(l)["data"]["frame_number"] for l in open(sys.argv[1])]; sys.exit(n != [1, 2, 3])' \
   "$WORK/steps.jsonl" || fail "stepped frames: $(cut -c1-200 "$WORK/steps.jsonl")"
 sleep 1  # a second in which nothing may come: the player is paused
-"$SKELGRAPH" player state --target player1 --json >"$WORK/st2.json"
+"$SKELGRAPH" player state --timeout 30 --target player1 --json >"$WORK/st2.json"
 json_check "$WORK/st2.json" 'd[0]["frames"] == 3'  # paused: nothing more
-if "$SKELGRAPH" player speed 2000 --target player1 2>/dev/null; then fail "speed 2000 accepted"; fi
-"$SKELGRAPH" player speed 0 --target player1 --json >"$WORK/st3.json"
+if "$SKELGRAPH" player speed --timeout 30 2000 --target player1 2>/dev/null; then fail "speed 2000 accepted"; fi
+"$SKELGRAPH" player speed --timeout 30 0 --target player1 --json >"$WORK/st3.json"
 json_check "$WORK/st3.json" 'd[0]["speed"] == 0 and d[0]["paused"]'
-"$SKELGRAPH" player resume --target player1 >/dev/null
+"$SKELGRAPH" player resume --timeout 30 --target player1 >/dev/null
 wait "$player" || fail "player: $(cat "$WORK/step.err")"
 json_check "$WORK/step.json" "$every_frame"
 ok "stepped 3 frames (numbers 1-2-3), held while paused, then played the other $((frames - 3)) at speed 0"

@@ -42,7 +42,7 @@ for sensor, rs in by.items():
     print("%s: %.1f Hz" % (sensor, rate))
 PY
 ok "raw: two sensors at ~30 Hz each, in their own frames"
-timeout 15 "$SKELGRAPH" topic echo skelgraph/calibration --count 2 --json --timeout 10 >"$WORK/poses.jsonl" ||
+timeout 40 "$SKELGRAPH" topic echo skelgraph/calibration --count 2 --json --timeout 30 >"$WORK/poses.jsonl" ||
   fail "sensor poses: expected two, got $(cat "$WORK/poses.jsonl")"
 python3 - "$WORK/poses.jsonl" <<'PY' || fail "sensor poses wrong: $(cat "$WORK/poses.jsonl")"
 import json, sys

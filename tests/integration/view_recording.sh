@@ -21,7 +21,7 @@ ok "recorded $FILE"
 "$SKELGRAPH" view "$FILE" --paused --port 8090 --json >"$WORK/view.json" 2>"$WORK/view.err" &
 view=$!
 wait_for_match "$WORK/view.err" "open $URL" 20 || fail "the viewer did not print its address: $(tail -3 "$WORK/view.err")"
-"$SKELGRAPH" player state --json >"$WORK/state0.json" || fail "no player state"
+"$SKELGRAPH" player state --timeout 30 --json >"$WORK/state0.json" || fail "no player state"
 # The player's length is the file's (bag info); the recording has most of its 6 s (on a busy machine the
 # first skeletons arrive later).
 "$SKELGRAPH" bag info "$FILE" --json >"$WORK/info.json" || fail "bag info"
@@ -44,14 +44,14 @@ PY
 ok "the page's Play, speed, Pause, timeline and Step drove the player"
 
 # The same from the command line; nonsense refused.
-"$SKELGRAPH" player seek 2.5 >/dev/null || fail "player seek"
-"$SKELGRAPH" player pause >/dev/null || fail "player pause"
+"$SKELGRAPH" player seek --timeout 30 2.5 >/dev/null || fail "player seek"
+"$SKELGRAPH" player pause --timeout 30 >/dev/null || fail "player pause"
 # The seek is answered once the player is there: the answer itself, and any state after it, carry the position.
-"$SKELGRAPH" player seek 2.5 --json >"$WORK/seek.json" || fail "player seek --json"
+"$SKELGRAPH" player seek --timeout 30 2.5 --json >"$WORK/seek.json" || fail "player seek --json"
 json_check "$WORK/seek.json" 'd[0]["paused"] and abs(d[0]["position_s"] - 2.5) < 0.05 and not d[0]["at_end"]'
-"$SKELGRAPH" player state --json >"$WORK/state1.json"
+"$SKELGRAPH" player state --timeout 30 --json >"$WORK/state1.json"
 json_check "$WORK/state1.json" 'd[0]["paused"] and abs(d[0]["position_s"] - 2.5) < 0.05 and not d[0]["at_end"]'
-if "$SKELGRAPH" player seek -- -1 2>"$WORK/neg.err"; then fail "a negative seek was accepted"; fi
+if "$SKELGRAPH" player seek --timeout 30 -- -1 2>"$WORK/neg.err"; then fail "a negative seek was accepted"; fi
 ok "player seek 2.5 from the command line; a negative position refused"
 
 kill -INT "$view"
