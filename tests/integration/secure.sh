@@ -32,13 +32,13 @@ wait_for_match "$WORK/tshark.err" "Capturing on" 10 || fail "tshark did not star
 # Hosts one after another (a second apart): participants that discover each other at
 # the same moment sometimes never finish authenticating with Fast DDS 2.9 (docs/security.md).
 for h in fusion sensor1 sensor2; do
-  spawn_sg "$h" "$WORK/$h.json" "$WORK/$h.err" launch "$SRC/bringup/cell.yaml" --host "$h" --duration 120 --json
+  spawn_sg "$h" "$WORK/$h.json" "$WORK/$h.err" launch "$SRC/bringup/cell.yaml" --host "$h" --duration 300 --json
   eval "p_$h=\$SPAWNED"
   sleep 1
 done
 # The robot: a host of its own (identity `arm`) in sensor1's namespace.
 printf 'components:\n  - {name: robot, type: robot, params: {robot_id: robot1}}\n' >"$WORK/arm.yaml"
-SKELGRAPH_HOST=arm spawn_sg sensor1 "$WORK/arm.json" "$WORK/arm.err" launch "$WORK/arm.yaml" --duration 120 --json
+SKELGRAPH_HOST=arm spawn_sg sensor1 "$WORK/arm.json" "$WORK/arm.err" launch "$WORK/arm.yaml" --duration 300 --json
 p_arm=$SPAWNED
 cell_started=$SECONDS
 
