@@ -104,7 +104,7 @@ components:
   - {name: separation, type: separation, params: {robot_id: robot1}}
   - {name: fetch, type: fetch, params: {robot_id: robot1, base: "1.4,0,0.7,180", label: pointing}}
 YAML
-"$SKELGRAPH" launch "$WORK/fetch.yaml" --duration 9 --json >"$WORK/fetch.json" 2>"$WORK/fetch.err" &
+"$SKELGRAPH" launch "$WORK/fetch.yaml" --duration 15 --json >"$WORK/fetch.json" 2>"$WORK/fetch.err" &
 fetch_launch=$!
 wait_for_match "$WORK/fetch.err" "\[start\] fetch" 20 || fail "fetch did not start: $(tail -5 "$WORK/fetch.err")"
 "$PUBLISH_GESTURE" 6 2>/dev/null

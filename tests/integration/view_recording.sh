@@ -11,7 +11,7 @@ SHOT=${SKELGRAPH_VIEWER_SCREENSHOT_DIR:-$(cd "$(dirname "$SKELGRAPH")/.." && pwd
 URL="http://127.0.0.1:8090/"
 
 # A 6 s recording of the simulated two-sensor cell.
-"$SKELGRAPH" launch bringup/sim_dual.yaml --duration 10 >/dev/null 2>"$WORK/sim.err" &
+"$SKELGRAPH" launch bringup/sim_dual.yaml --duration 60 >/dev/null 2>"$WORK/sim.err" &  # stopped once recorded
 sim=$!
 "$SKELGRAPH" bag record --now --dir "$WORK/rec" --duration 6 >/dev/null 2>"$WORK/rec.err" || fail "bag record: $(tail -3 "$WORK/rec.err")"
 kill -INT "$sim"; wait "$sim" || true
