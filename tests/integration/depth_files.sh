@@ -76,16 +76,21 @@ import json, sys
 d = json.load(open(sys.argv[1]))
 problems = []
 if d["with_a_person"] != 12: problems.append(f'{d["with_a_person"]} of 12 images with a person')
-# The nearest person's reported joints on the person (measured 2026-12-05: 115 of 131); the legs, below the image, not reported.
+# The nearest person's reported joints on the person (measured 2026-12-06: 127 of 132; 115 of 131 before
+# hands held out, bent arms and free space), at most two off in any image; the legs, below the image, not reported.
 share = d["nearest_joints_on_person"] / max(1, d["nearest_joints_reported"])
-if share < 0.8: problems.append(f"only {share:.0%} of the joints on the person")
+if share < 0.95: problems.append(f"only {share:.0%} of the joints on the person")
+for f in d["files"]:
+    for s in f["skeletons"]:
+        off = [n for n, j in s["joints"].items() if not j["on_person"]]
+        if s["nearest"] and len(off) > 2: problems.append(f'{f["file"]}: {len(off)} joints off the person: {off}')
 for f in d["files"]:
     for s in f["skeletons"]:
         if s["nearest"] and any(j in s["joints"] for j in ("left_foot", "right_foot")):
             problems.append(f'{f["file"]}: a foot reported in a view cut off at the waist')
-# Bones the same length in every image (measured: sd 0.4-1.5 cm).
+# Bones the same length in every image (measured: sd 0.6-0.8 cm).
 for name, b in d["bones"].items():
-    if b["images"] < 10 or b["sd_m"] > 0.03: problems.append(f'{name}: {b}')
+    if b["images"] < 12 or b["sd_m"] > 0.015: problems.append(f'{name}: {b}')
 print("\n".join(problems), file=sys.stderr)
 sys.exit(1 if problems else 0)
 PY

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <fstream>
 
 #include "skelgraph/depth_tracker/frame_matcher.hpp"
 #include "skelgraph/depth_tracker/image_check.hpp"
@@ -244,6 +246,79 @@ TEST(DepthTracker, FitsKeepTheJointLimitsThatTheTruthKeeps) {
     EXPECT_LE(on[1], 5) << scenario;
     EXPECT_LE(20 * on[1], off[1]) << scenario;
   }
+}
+
+// A close view from the waist up (no floor in sight) of a real Kinect: both
+// hands held out towards the sensor hide their forearms, and depth steps all
+// round them make them regions of their own, 0.35 m from the trunk's nearest
+// point. They are the person's: one group holds them, the fitted hands lie in
+// them. Without joining such parts the hands are left out of the person.
+TEST(DepthTracker, HandsHeldOutTowardsTheSensorAreThePersons) {
+  const char* env = std::getenv("SKELGRAPH_DATA_DIR");
+  const char* src = std::getenv("SKELGRAPH_SOURCE_DIR");
+  const std::string file = (env ? std::string(env) : std::string(src ? src : ".") + "/../shared/data") +
+                           "/skeltrack-depth/depth-data-1078881076";
+  std::ifstream in(file, std::ios::binary);
+  ASSERT_TRUE(in) << file << " is missing: tests read ../shared/data (or SKELGRAPH_DATA_DIR)";
+  auto img = depth::DepthImage::blank(depth::kinect_intrinsics(640, 480));
+  std::vector<unsigned char> bytes(img.mm.size() * 2);
+  in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  ASSERT_EQ(in.gcount(), static_cast<std::streamsize>(bytes.size()));
+  for (std::size_t i = 0; i < img.mm.size(); ++i) img.mm[i] = static_cast<std::uint16_t>(bytes[2 * i] | bytes[2 * i + 1] << 8);
+  Eigen::Isometry3d level = Eigen::Isometry3d::Identity();
+  level.translation() = Eigen::Vector3d(0, 1.2, 0);  // the tracker's default pose: level, 1.2 m up
+  const auto depth_of = [&](const depth_tracker::PersonPoints& p) {
+    double nearest = 1e9;
+    for (const auto& q : p.points) nearest = std::min(nearest, (level.inverse() * q.cast<double>()).z());
+    return nearest;
+  };
+  depth_tracker::TrackerOptions off;
+  off.hand_reach_m = 0.0;
+  const auto with = depth_tracker::find_people(img, level);
+  const auto without = depth_tracker::find_people(img, level, off);
+  ASSERT_EQ(with.size(), 1u);
+  ASSERT_EQ(without.size(), 1u);
+  EXPECT_LT(depth_of(with[0]), 0.8);     // the hands, 0.75 m from the sensor
+  EXPECT_GT(depth_of(without[0]), 1.0);  // the trunk only, 1.2 m
+  depth_tracker::DepthTracker tracker;
+  const auto out = tracker.track(img);
+  ASSERT_EQ(out.size(), 1u);
+  for (const auto hand : {JointId::LeftHand, JointId::RightHand}) {
+    EXPECT_LT(out[0][hand].position.z(), 0.9) << skeleton::joint_name(hand);  // the trunk is at 1.24 m
+  }
+  // Every joint reported lies on the person. The elbows are behind the hands,
+  // hidden: without the free-space term the fit holds them out in the air in
+  // front of the trunk, where the sensor would have seen them.
+  const auto off_person = [&](const std::vector<skeleton::Skeleton>& people) {
+    int off = 0;
+    for (const auto& j : people.at(0).joints) off += j.confidence > 0 && !depth_tracker::on_surface(img, j.position);
+    return off;
+  };
+  EXPECT_EQ(off_person(out), 0);
+  depth_tracker::TrackerOptions no_free_space;
+  no_free_space.free_space_weight = 0.0;
+  depth_tracker::DepthTracker blind(no_free_space);
+  EXPECT_GE(off_person(blind.track(img)), 2);
+}
+
+// The height of a new person is their head's top, not their raised hands'.
+TEST(DepthTracker, HandsRaisedAboveTheHeadDoNotMakeThePersonTaller) {
+  const auto cfg = sensor_at({0.0, 1.2, 3.0}, 180.0);
+  sim::DepthRenderer r(cfg, depth::kinect_intrinsics(320, 240));
+  const auto seen = [&](double elevation) {
+    sim::BodyPose pose;
+    pose.left_arm.elevation = pose.right_arm.elevation = elevation;
+    pose.left_arm.azimuth = pose.right_arm.azimuth = M_PI / 2;
+    sim::Rng rng(4);
+    return depth_tracker::find_people(shot(r, {sim::forward_kinematics(sim::BodyDimensions::from_height(1.75), pose)}, rng, 0),
+                                      cfg.world_from_sensor());
+  };
+  const auto down = seen(0.2), up = seen(2.7);  // arms hanging; raised, a little out
+  ASSERT_EQ(down.size(), 1u);
+  ASSERT_EQ(up.size(), 1u);
+  EXPECT_GT(up[0].top, up[0].crown + 0.2);          // the region's top: the hands
+  EXPECT_NEAR(up[0].crown, down[0].crown, 0.03);    // its crown: the head, as with the arms down
+  EXPECT_NEAR(down[0].crown, down[0].top, 0.03);
 }
 
 // The check `skelgraph depth track` uses on real depth: a joint is on the

@@ -204,8 +204,15 @@ struct DepthTracker::Impl {
     double inliers = 0.0;   // their share of the points
     double score() const { return mean_abs + 0.1 * (1.0 - inliers); }
   };
+  // The images of the frame being tracked, for the free-space term of the fit.
+  struct View {
+    const depth::DepthImage* image;
+    Eigen::Isometry3d sensor_from_world;
+  };
+  std::vector<View> views;
   // Fits `person` to the points.
   Fit fit(Person& person, const depth::Points& points, int iterations) const;
+  Fit start(Person& person, const PersonPoints& found, const Eigen::Vector3d& viewpoint, double height) const;
   std::vector<skeleton::Skeleton> step(std::vector<PersonPoints> found, std::int64_t stamp_ns,
                                        const std::vector<Vector3d>& viewpoints);
 };
@@ -238,6 +245,11 @@ DepthTracker::Impl::Fit DepthTracker::Impl::fit(Person& person, const depth::Poi
   Fit result;
   std::vector<double> radius(segs.size());
   for (std::size_t s = 0; s < segs.size(); ++s) radius[s] = segs[s].radius * person.height;
+  // Per joint, the thickest capsule it ends (its footprint in the image).
+  std::array<double, kJ> joint_radius{};
+  for (std::size_t s = 0; s < segs.size(); ++s)
+    for (const auto j : {segs[s].from.a, segs[s].from.b, segs[s].to.a, segs[s].to.b})
+      joint_radius[j] = std::max(joint_radius[j], radius[s]);
   std::vector<int> inliers(segs.size());
   for (int it = 0; it < iterations; ++it) {
     Mat A = Mat::Zero();
@@ -325,6 +337,45 @@ DepthTracker::Impl::Fit DepthTracker::Impl::fit(Person& person, const depth::Poi
         }
       }
     }
+    // Free space: a limb the sensor would have seen is in the image (an
+    // elbow held out in front of the trunk would be). A joint whose pixel
+    // shows a surface more than free_space_m behind it is in the air, unless
+    // its limb's own surface is beside it: a reading, within the footprint
+    // (a disc of the limb's radius about the pixel), at about the depth of
+    // the limb's front. (Beside a thin limb the pixel shows the room behind
+    // it.) A pixel nearer than the limb's front hides the joint; pixels
+    // without a reading say nothing (holes, removed background).
+    if (opt.free_space_weight > 0) {
+      for (const auto& view : views) {
+        const auto& img = *view.image;
+        const Eigen::RowVector3d gz = view.sensor_from_world.linear().row(2);
+        const auto reading = [&](double u, double v) -> double {
+          const long iu = std::lround(u), iv = std::lround(v);
+          if (iu < 0 || iv < 0 || iu >= img.width() || iv >= img.height()) return 0.0;
+          return img.at(static_cast<int>(iu), static_cast<int>(iv)) * 1e-3;
+        };
+        for (std::size_t k = 0; k < kJ; ++k) {
+          const Vector3d ps = view.sensor_from_world * x[k];
+          if (ps.z() <= 0.05) continue;
+          const auto px = depth::project(img.intrinsics, ps);
+          const double seen = reading(px.x(), px.y());
+          const double front = ps.z() - joint_radius[k] - opt.free_space_m;  // nearer than this: something in front of the limb
+          if (seen <= 0 || seen < front || seen <= ps.z() + opt.free_space_m) continue;
+          const double r_px = img.intrinsics.fx * joint_radius[k] / ps.z();
+          bool limb_beside = false;
+          for (int i = -2; i <= 2 && !limb_beside; ++i) {
+            for (int j = -2; j <= 2 && !limb_beside; ++j) {
+              if (i * i + j * j > 4) continue;
+              const double r = reading(px.x() + r_px * i / 2.0, px.y() + r_px * j / 2.0);
+              limb_beside = r > 0 && r >= front && r <= ps.z() + opt.free_space_m;
+            }
+          }
+          if (limb_beside) continue;
+          const double e = ps.z() - (seen - opt.free_space_m);
+          if (e > -opt.free_space_depth_m) add_residual(A, b, {{k, gz.transpose()}}, e, opt.free_space_weight);
+        }
+      }
+    }
     // Towards the previous frame's pose, and a little damping.
     for (std::size_t k = 0; k < kJ; ++k) {
       A.block<3, 3>(3 * static_cast<int>(k), 3 * static_cast<int>(k)) +=
@@ -388,19 +439,42 @@ std::vector<PersonPoints> find_people(const depth::DepthImage& image, const Eige
   }
   // Largest first (segment() sorts regions by size): each part joins the first group standing within 0.45 m;
   // in a close view cut off below, a part touching a group (points within 10 cm: an arm held out in front
-  // of the trunk, split from it by the depth step) joins it too.
+  // of the trunk, split from it by the depth step) joins it too, and so does a hand held out (below).
   const auto touching = [](const Candidate& a, const Candidate& b) {
     for (const auto& p : a.points)
       for (const auto& q : b.points)
         if ((p - q).squaredNorm() < 0.01f) return true;
     return false;
   };
+  // A hand held out towards the sensor is its own region (the forearm behind
+  // it is hidden, the depth steps at its edge): a part no bigger than a hand
+  // or forearm, nearer the sensor than a group and within reach of its points,
+  // joins that group. (On ../shared/data/skeltrack-depth such hands are
+  // 0.35-0.5 m in front of the trunk and 9-35 cm from its nearest point.)
+  const Vector3d eye = t;
+  const auto reach_part = [&](const Candidate& part, const Candidate& g) {
+    Eigen::AlignedBox3d box;
+    for (const auto& p : part.points) box.extend(p.cast<double>());
+    if (box.sizes().maxCoeff() > opt.max_hand_part_m) return false;
+    if ((part.centre - eye).norm() >= (g.centre - eye).norm()) return false;
+    const float r2 = static_cast<float>(opt.hand_reach_m * opt.hand_reach_m);
+    for (const auto& p : part.points)
+      for (const auto& q : g.points)
+        if ((p - q).squaredNorm() < r2) return true;
+    return false;
+  };
   std::vector<Candidate> groups;
+  const auto join = [](Candidate& home, Candidate& part) {
+    const double n0 = static_cast<double>(home.points.size()), n1 = static_cast<double>(part.points.size());
+    home.centre = (home.centre * n0 + part.centre * n1) / (n0 + n1);
+    home.cut_at_bottom = home.cut_at_bottom || part.cut_at_bottom;
+    home.points.insert(home.points.end(), part.points.begin(), part.points.end());
+  };
   for (auto& part : parts) {
     Candidate* home = nullptr;
     for (auto& g : groups) {
       if (std::hypot(g.centre.x() - part.centre.x(), g.centre.z() - part.centre.z()) < 0.45 ||
-          (part.cut_at_bottom && g.cut_at_bottom && touching(part, g))) {
+          (part.cut_at_bottom && g.cut_at_bottom && touching(part, g)) || reach_part(part, g)) {
         home = &g;
         break;
       }
@@ -409,10 +483,7 @@ std::vector<PersonPoints> find_people(const depth::DepthImage& image, const Eige
       groups.push_back(std::move(part));
       continue;
     }
-    const double n0 = static_cast<double>(home->points.size()), n1 = static_cast<double>(part.points.size());
-    home->centre = (home->centre * n0 + part.centre * n1) / (n0 + n1);
-    home->cut_at_bottom = home->cut_at_bottom || part.cut_at_bottom;
-    home->points.insert(home->points.end(), part.points.begin(), part.points.end());
+    join(*home, part);
   }
   std::vector<Candidate> found;
   for (auto& g : groups) {
@@ -426,6 +497,27 @@ std::vector<PersonPoints> find_people(const depth::DepthImage& image, const Eige
     const auto k = static_cast<long>(ys.size() * 98 / 100);
     std::nth_element(ys.begin(), ys.begin() + k, ys.end());
     g.top = ys[static_cast<std::size_t>(k)];
+    // The head's top: the top of the points over the group's middle (its
+    // median place across), so that hands raised beside the head do not make
+    // the person taller.
+    std::vector<double> xs, zs;
+    for (const auto& p : g.points) {
+      xs.push_back(p.x());
+      zs.push_back(p.z());
+    }
+    const auto mid = xs.size() / 2;
+    std::nth_element(xs.begin(), xs.begin() + static_cast<long>(mid), xs.end());
+    std::nth_element(zs.begin(), zs.begin() + static_cast<long>(mid), zs.end());
+    std::vector<double> middle;
+    for (const auto& p : g.points) {
+      if (std::hypot(p.x() - xs[mid], p.z() - zs[mid]) < 0.25) middle.push_back(p.y());
+    }
+    g.crown = g.top;
+    if (middle.size() >= 10) {
+      const auto m = static_cast<long>(middle.size() * 98 / 100);
+      std::nth_element(middle.begin(), middle.begin() + m, middle.end());
+      g.crown = std::min(g.top, middle[static_cast<std::size_t>(m)]);
+    }
     const double width = std::hypot(box.sizes().x(), box.sizes().z());
     if (g.top < opt.min_height_m || g.top > opt.max_height_m || width > opt.max_width_m) continue;
     // An arm, a box: not a whole person; unless the image cut it off below (a close, upper-body view).
@@ -443,6 +535,90 @@ std::vector<PersonPoints> find_people(const depth::DepthImage& image, const Eige
     found.push_back(std::move(g));
   }
   return found;
+}
+
+// A new person from a person-shaped group of points: a standing template
+// `height` tall, its head's top at the group's crown, turned every 45 degrees,
+// then each arm tried in many poses; the best explanation of the points.
+DepthTracker::Impl::Fit DepthTracker::Impl::start(Person& p, const PersonPoints& found, const Vector3d& viewpoint,
+                                                  double height) const {
+  const double crown = found.crown;
+  Vector3d to_sensor = viewpoint - found.centre;
+  to_sensor.y() = 0.0;
+  if (to_sensor.norm() < 1e-6) to_sensor = Vector3d::UnitZ();
+  to_sensor.normalize();
+  // The points are the front of the body: its middle is about a hand's breadth behind them.
+  const Vector3d centre = found.centre - 0.1 * to_sensor;
+  // A standing template `h` tall whose head's top is at the crown (on the floor when h is the crown).
+  const auto template_of = [&](double h, const Vector3d& fwd) {
+    Person trial = p;
+    trial.height = h;
+    trial.pose = standing(h, centre, fwd);
+    for (auto& j : trial.pose) j.y() += crown - h;
+    trial.lengths.clear();
+    for (const auto& [ja, jb] : links()) trial.lengths.push_back((trial.pose[idx(ja)] - trial.pose[idx(jb)]).norm());
+    return trial;
+  };
+  // Which way they face is not known: fit a standing template turned every
+  // 45 degrees and keep the best (facing the sensor wins ties).
+  Fit best_fit;
+  for (int k = 0; k < 8; ++k) {
+    const double a = k * M_PI / 4.0;
+    Person trial = template_of(height, Eigen::AngleAxisd(a, Vector3d::UnitY()) * to_sensor);
+    const auto f = fit(trial, found.points, opt.init_iterations);
+    if (k == 0 || f.score() < best_fit.score() - 1e-3) {
+      best_fit = f;
+      p = trial;
+    }
+  }
+  // Arms need not hang at the start: try each arm's upper arm and forearm
+  // down, forward, out, up and in between (straight or bent at the elbow:
+  // a fist raised from an arm held out, a hand held forward from an arm
+  // hanging), rank the tries by a short fit and refine the best few; keep
+  // what explains the points best.
+  const Vector3d up = Vector3d::UnitY();
+  const Vector3d left_dir = (p.pose[idx(JointId::LeftShoulder)] - p.pose[idx(JointId::RightShoulder)]).normalized();
+  const Vector3d fwd = left_dir.cross(up).normalized();
+  for (const auto& [sh, el, ha, out_sign] : {std::tuple{JointId::LeftShoulder, JointId::LeftElbow, JointId::LeftHand, 1.0},
+                                             std::tuple{JointId::RightShoulder, JointId::RightElbow, JointId::RightHand, -1.0}}) {
+    const Vector3d side = out_sign * left_dir;
+    const std::array<Vector3d, 9> dirs = {-up, fwd, side, up, Vector3d((fwd - up).normalized()), Vector3d((fwd + up).normalized()),
+                                          Vector3d((side - up).normalized()), Vector3d((side + up).normalized()),
+                                          Vector3d((side + fwd).normalized())};
+    const double upper = (p.pose[idx(el)] - p.pose[idx(sh)]).norm();
+    const double fore = (p.pose[idx(ha)] - p.pose[idx(el)]).norm();
+    const auto arm_at = [&](const Vector3d& du, const Vector3d& df) {
+      Person trial = p;
+      trial.pose[idx(el)] = trial.pose[idx(sh)] + upper * du;
+      trial.pose[idx(ha)] = trial.pose[idx(el)] + fore * df;
+      return trial;
+    };
+    struct Try {
+      double score;
+      std::size_t upper, fore;
+    };
+    std::vector<Try> tries;
+    for (std::size_t u = 0; u < dirs.size(); ++u) {
+      for (std::size_t f = 0; f < dirs.size(); ++f) {
+        if (dirs[u].dot(dirs[f]) < -0.5) continue;  // folded back past the elbow's limit
+        Person trial = arm_at(dirs[u], dirs[f]);
+        tries.push_back({fit(trial, found.points, 2).score(), u, f});
+      }
+    }
+    const std::size_t keep = std::min<std::size_t>(3, tries.size());
+    std::partial_sort(tries.begin(), tries.begin() + static_cast<std::ptrdiff_t>(keep), tries.end(),
+                      [](const Try& a, const Try& b) { return a.score < b.score; });
+    for (std::size_t k = 0; k < keep; ++k) {
+      Person trial = arm_at(dirs[tries[k].upper], dirs[tries[k].fore]);
+      const auto f = fit(trial, found.points, opt.init_iterations / 2);
+      if (f.score() < best_fit.score() - 1e-3) {
+        best_fit = f;
+        p.pose = trial.pose;
+        p.support = trial.support;
+      }
+    }
+  }
+  return best_fit;
 }
 
 // Continues and starts people from this frame's person-shaped groups (world
@@ -473,56 +649,14 @@ std::vector<skeleton::Skeleton> DepthTracker::Impl::step(std::vector<PersonPoint
   }
   for (std::size_t c = 0; c < found.size(); ++c) {
     if (used[c]) continue;
+    // The height is the head's top above the floor. (Cut off below, a close
+    // view's floor is out of sight and so its height only as good as the
+    // sensor's assumed pose: trying several heights and keeping the best
+    // fit was tried on ../shared/data/skeltrack-depth, and the fits did not
+    // settle on one person's size.)
     Person p;
+    const auto best_fit = start(p, found[c], viewpoints.front(), std::clamp(found[c].crown, 1.0, 2.3));
     p.id = next_id++;
-    p.height = std::clamp(found[c].top, 1.0, 2.3);
-    Vector3d to_sensor = viewpoints.front() - found[c].centre;
-    to_sensor.y() = 0.0;
-    if (to_sensor.norm() < 1e-6) to_sensor = Vector3d::UnitZ();
-    to_sensor.normalize();
-    // The points are the front of the body: its middle is about a hand's breadth behind them.
-    const Vector3d centre = found[c].centre - 0.1 * to_sensor;
-    // Which way they face is not known: fit a standing template turned every
-    // 45 degrees and keep the best (facing the sensor wins ties).
-    Fit best_fit;
-    for (int k = 0; k < 8; ++k) {
-      const double a = k * M_PI / 4.0;
-      const Vector3d fwd = Eigen::AngleAxisd(a, Vector3d::UnitY()) * to_sensor;
-      Person trial = p;
-      trial.pose = standing(p.height, centre, fwd);
-      trial.lengths.clear();
-      for (const auto& [ja, jb] : links()) trial.lengths.push_back((trial.pose[idx(ja)] - trial.pose[idx(jb)]).norm());
-      const auto f = fit(trial, found[c].points, opt.init_iterations);
-      if (k == 0 || f.score() < best_fit.score() - 1e-3) {
-        best_fit = f;
-        p.pose = trial.pose;
-        p.lengths = trial.lengths;
-        p.support = trial.support;
-      }
-    }
-    // Arms need not hang at the start: try each arm down, forward, out, up and
-    // in between, and keep what explains the points best.
-    const Vector3d up = Vector3d::UnitY();
-    const Vector3d left_dir = (p.pose[idx(JointId::LeftShoulder)] - p.pose[idx(JointId::RightShoulder)]).normalized();
-    const Vector3d fwd = left_dir.cross(up).normalized();
-    for (const auto& [sh, el, ha, out_sign] : {std::tuple{JointId::LeftShoulder, JointId::LeftElbow, JointId::LeftHand, 1.0},
-                                               std::tuple{JointId::RightShoulder, JointId::RightElbow, JointId::RightHand, -1.0}}) {
-      const Vector3d side = out_sign * left_dir;
-      for (const Vector3d& dir : {fwd, side, up, Vector3d((fwd - up).normalized()), Vector3d((fwd + up).normalized()),
-                                  Vector3d((side - up).normalized()), Vector3d((side + fwd).normalized())}) {
-        Person trial = p;
-        const double upper = (p.pose[idx(el)] - p.pose[idx(sh)]).norm();
-        const double fore = (p.pose[idx(ha)] - p.pose[idx(el)]).norm();
-        trial.pose[idx(el)] = trial.pose[idx(sh)] + upper * dir;
-        trial.pose[idx(ha)] = trial.pose[idx(el)] + fore * dir;
-        const auto f = fit(trial, found[c].points, opt.init_iterations / 2);
-        if (f.score() < best_fit.score() - 1e-3) {
-          best_fit = f;
-          p.pose = trial.pose;
-          p.support = trial.support;
-        }
-      }
-    }
     stats.mean_residual_m = best_fit.mean_abs;
     p.last_seen_ns = stamp_ns;
     ++stats.initialisations;
@@ -585,7 +719,9 @@ std::vector<skeleton::Skeleton> DepthTracker::track(const depth::DepthImage& ima
   depth::check(image);
   auto& d = *impl_;
   ++d.stats.frames;
+  d.views = {{&image, d.world_from_sensor.inverse()}};
   auto out = d.step(find_people(image, d.world_from_sensor, d.opt), image.stamp_ns, {d.world_from_sensor.translation()});
+  d.views.clear();
   const Eigen::Isometry3d sensor_from_world = d.world_from_sensor.inverse();
   for (auto& s : out) {
     s.sensor_id = image.sensor_id;
@@ -629,11 +765,14 @@ std::vector<skeleton::Skeleton> DepthTracker::track_merged(const std::vector<dep
       const double n0 = static_cast<double>(home->points.size()), n1 = static_cast<double>(p.points.size());
       home->centre = (home->centre * n0 + p.centre * n1) / (n0 + n1);
       home->top = std::max(home->top, p.top);
+      home->crown = std::max(home->crown, p.crown);
       home->points.insert(home->points.end(), p.points.begin(), p.points.end());
     }
   }
   for (auto& m : merged) m.points = depth::voxel_downsample(m.points, d.opt.voxel_m);
+  for (std::size_t i = 0; i < images.size(); ++i) d.views.push_back({&images[i], poses[i].inverse()});
   auto out = d.step(std::move(merged), stamp, viewpoints);
+  d.views.clear();
   for (auto& s : out) {
     s.sensor_id = id;
     s.frame_number = d.stats.frames;

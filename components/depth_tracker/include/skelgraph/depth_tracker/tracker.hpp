@@ -60,6 +60,8 @@ struct TrackerOptions {
   double max_distance_m = 5.0;     // ... and this close to the sensor (Kinect-class trackers reach ~4 m)
   double max_width_m = 2.2;        // ... and horizontal extent (arms spread: about the height)
   std::size_t min_points = 60;     // ... and points after thinning
+  double max_hand_part_m = 0.4;    // a region no bigger than this across (a hand or forearm held out) ...
+  double hand_reach_m = 0.45;      // ... nearer the sensor than a person and this close to them is theirs
   double outlier_m = 0.15;         // points farther than this from the model's surface are ignored
   double bone_weight = 30.0;       // per bone, against one point
   double smooth_weight = 0.5;      // per joint, pull towards the previous frame's pose
@@ -68,6 +70,9 @@ struct TrackerOptions {
   double tracked_support = 8;      // points on a joint's segments for confidence 1
   JointLimits limits;
   double limit_weight = 200.0;     // per broken limit, against one point; 0 turns the limits off
+  double free_space_m = 0.03;      // a joint may lie this far in front of the surface seen at its pixel ...
+  double free_space_weight = 100.0;  // ... beyond it, this penalty (against one point; 0: off) ...
+  double free_space_depth_m = 0.3;   // ... up to this far in front (farther: the joint is beside a thin limb, the pixel the room behind)
 };
 
 // How far a skeleton breaks the limits: the worst amount per limit (0 when
@@ -90,6 +95,7 @@ struct PersonPoints {
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   double top = 0.0;  // height of its top above the floor, m
   bool cut_at_bottom = false;  // reaches the image's lower edge: the legs are out of view
+  double crown = 0.0;  // the height of its top over its middle (the head's; hands raised beside it aside), m
 };
 // The people in a depth image (step 1 above), without fitting anyone: for
 // point clouds of people and for tests. Throws std::invalid_argument for a malformed image.
