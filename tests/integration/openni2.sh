@@ -26,10 +26,13 @@ assert all(x["width"] == 320 and x["height"] == 240 and x["depth_mm_count"] == 7
 PY
 }
 retry 5 both_devices || fail "depth samples: $(cat "$WORK/echo.err") $(head -c 600 "$WORK/echo.jsonl")"
+session_start=$SECONDS
 "$SKELGRAPH" sync start --label oni --timeout 10 >/dev/null || fail "sync start"
 # A session of about 3 s: while 180 frames of the two devices go by.
 "$SKELGRAPH" topic echo skelgraph/depth --count 180 --json --timeout 15 >/dev/null 2>&1 || fail "depth stopped during the session"
 "$SKELGRAPH" sync stop --timeout 10 >/dev/null || fail "sync stop"
+# At most 30 Hz of the session as long as it took here (a busy machine's discovery makes it longer than 3 s).
+max_frames=$(( 30 * (SECONDS - session_start + 2) ))
 kill -INT "$live" "$raw"
 wait "$live" || fail "launch: $(tail -5 "$WORK/live.err")"
 wait "$raw" || fail "raw recorder: $(tail -5 "$WORK/raw.err")"
@@ -51,8 +54,8 @@ json_check "$WORK/mend.json" 'd[0]["streams_mended"] == 1'
 json_check "$WORK/mend2.json" 'd[0]["streams_mended"] == 0'
 for f in "$unmended" "$WORK/mended.oni"; do
   "$SKELGRAPH" oni info "$f" --read --json >"$WORK/info.json" || fail "info $f"
-  # About 3 s at 30 Hz, every frame read back, the Dummy's pattern in it.
-  json_check "$WORK/info.json" '60 <= d["frames"] <= 300 and d["frames_read"] == d["frames"] and d["valid_fraction"] > 0.004'
+  # At least 2 s at 30 Hz, no more than the session took, every frame read back, the Dummy's pattern in it.
+  json_check "$WORK/info.json" '60 <= d["frames"] <= '"$max_frames"' and d["frames_read"] == d["frames"] and d["valid_fraction"] > 0.004'
 done
 frames=$(json_get "$WORK/info.json" 'd["frames"]')
 ok "recorded $frames frames; unmended file plays nothing (pinned), mended plays all"

@@ -166,17 +166,35 @@ YAML
 "$SKELGRAPH" launch "$WORK/gesture_stop.yaml" --duration 60 --json >"$WORK/gesture_stop.json" 2>"$WORK/gesture_stop.err" &
 gs=$!
 wait_for_match "$WORK/gesture_stop.err" "\[start\] separation" 20 || fail "gesture_stop graph did not start"
-# The monitor's latest verdict (transient-local: the newest at once) until it is STATE.
-verdict_is() {
-  "$SKELGRAPH" topic echo skelgraph/safety --json --count 1 --timeout 5 >"$WORK/gs_state.json" 2>/dev/null &&
-    python3 -c 'import json, sys; d = json.load(open(sys.argv[1]))["data"]; sys.exit(0 if d["state"] == sys.argv[2] and sys.argv[3] in d["reason"] else 1)' \
-      "$WORK/gs_state.json" "$1" "${2:-}"
+# Every verdict the monitor publishes, from one reader started before the gesture: the stop lasts only
+# gesture_stop_s, and a reader started anew for each look may take longer than that to find the
+# monitor on a busy machine.
+"$SKELGRAPH" topic echo skelgraph/safety --json >"$WORK/gs_verdicts.jsonl" 2>"$WORK/gs_echo.err" &
+gs_echo=$!
+wait_for_match "$WORK/gs_echo.err" "echo: matched" 60 || fail "no reader of skelgraph/safety: $(cat "$WORK/gs_echo.err")"
+# Until the verdicts show, in this order, each (STATE, text in the reason) of the arguments.
+verdicts_show() {
+  python3 - "$WORK/gs_verdicts.jsonl" "$@" <<'PY'
+import json, sys
+want = [tuple(a.split(":", 1)) for a in sys.argv[2:]]
+k = 0
+for line in open(sys.argv[1]):
+    try:
+        d = json.loads(line)["data"]
+    except (ValueError, KeyError):
+        continue  # a line still being written
+    if k < len(want) and d["state"] == want[k][0] and want[k][1] in d["reason"]:
+        k += 1
+sys.exit(0 if k == len(want) else 1)
+PY
 }
-wait_verdict() { for _ in $(seq 30); do verdict_is "$@" && return 0; done; return 1; }
-wait_verdict RUN || fail "the monitor never ran with the worker 8 m away: $(cat "$WORK/gs_state.json")"
-"$PUBLISH_GESTURE" 1 stop 2>/dev/null
-wait_verdict PROTECTIVE_STOP "stop gesture by person 7" || fail "no stop for the gesture: $(cat "$WORK/gs_state.json")"
-wait_verdict RUN || fail "the robot did not run again after gesture_stop_s: $(cat "$WORK/gs_state.json")"
+wait_verdicts() { local deadline=$((SECONDS + 60)); until verdicts_show "$@"; do [ "$SECONDS" -lt "$deadline" ] || return 1; python3 -c 'import time; time.sleep(0.2)'; done; }
+wait_verdicts "RUN:" || fail "the monitor never ran with the worker 8 m away: $(tail -2 "$WORK/gs_verdicts.jsonl")"
+"$PUBLISH_GESTURE" 1 stop 2>/dev/null || fail "the stop gesture was not published"
+wait_verdicts "RUN:" "PROTECTIVE_STOP:stop gesture by person 7" || fail "no stop for the gesture: $(tail -2 "$WORK/gs_verdicts.jsonl")"
+wait_verdicts "RUN:" "PROTECTIVE_STOP:stop gesture by person 7" "RUN:" ||
+  fail "the robot did not run again after gesture_stop_s: $(tail -2 "$WORK/gs_verdicts.jsonl")"
+kill "$gs_echo" 2>/dev/null || true
 kill -INT "$gs"
 wait "$gs" || fail "gesture_stop launch: $(tail -3 "$WORK/gesture_stop.err")"
 json_check "$WORK/gesture_stop.json" '[c for c in d["components"] if c["name"] == "separation"][0]["details"]["stop_gestures"] >= 1 and [c for c in d["components"] if c["name"] == "robot"][0]["details"]["protective_stops"] >= 1'
