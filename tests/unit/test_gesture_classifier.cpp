@@ -492,6 +492,27 @@ AnnotatedStream synthetic_stream(const std::string& subject, std::uint64_t seed)
 }
 }  // namespace
 
+// Near misses: garbage windows that end at the given offsets from each
+// action point, unless another action point is within 0.3 s of that end.
+TEST(StreamSpotting, NearMissesAreGarbageUnlessAnotherGestureIsThere) {
+  auto s = synthetic_stream("s0", 11);
+  const auto map = stream_class_map({s});
+  const auto garbage = [&](const StreamSpotOptions& o) {
+    int n = 0;
+    for (const auto& w : stream_windows(s, map, o)) n += w.action == "none" ? 1 : 0;
+    return n;
+  };
+  StreamSpotOptions without, with;
+  without.near_negative_offsets_s.clear();
+  with.near_negative_offsets_s = {-0.7, -0.5, 0.5, 0.7};
+  EXPECT_EQ(garbage(with) - garbage(without), 12 * 4);
+  // A second "A" 0.5 s after the first: the first's +0.5 and +0.7 and the second's -0.5 and -0.7 fall within 0.3 s
+  // of the other one and are not garbage; the second's +0.5 and +0.7 are (the third is 4.2 s on). The plain garbage
+  // windows stay at least 0.8 s from both.
+  s.annotations.insert(s.annotations.begin() + 1, {"A", s.annotations[0].end_ns + 500'000'000, s.annotations[0].end_ns + 500'000'000});
+  EXPECT_EQ(garbage(with) - garbage(without), 11 * 4 + 2 + 2);  // the other 11, the first's two before, the second's two after
+}
+
 TEST(StreamSpotting, FindsEachGestureNearItsActionPoint) {
   std::vector<AnnotatedStream> streams;
   for (int subject = 0; subject < 3; ++subject) streams.push_back(synthetic_stream("s" + std::to_string(subject), 11 + subject));

@@ -3,6 +3,7 @@
 // libraries.
 
 #include <memory>
+#include <sstream>
 
 #include "cmd_gesture.hpp"
 #include "skelgraph/gesture/builtin_models.hpp"
@@ -27,6 +28,28 @@ void add_stream_options(CLI::App* c, GestureOptions& o, const std::string& what)
   c->add_option("--confirm", o.stream.confirm, "--spot: windows in a row one gesture must win (default 2)")->check(CLI::Range(1, 50));
   c->add_option("--refractory", o.stream.refractory_s, "--spot: s without another event of the same class (default 1.5)")
       ->check(CLI::Range(0.0, 30.0));
+  c->add_option_function<std::string>(
+       "--near-misses",
+       [&o](const std::string& v) {
+         o.stream.near_negative_offsets_s.clear();
+         if (v == "none") return;
+         std::stringstream in(v);
+         for (std::string item; std::getline(in, item, ',');) {
+           std::size_t used = 0;
+           double d = 0;
+           try {
+             d = std::stod(item, &used);
+           } catch (const std::exception&) {
+             used = 0;
+           }
+           if (used == 0 || used != item.size() || !(d >= -5.0 && d <= 5.0))
+             throw CLI::ValidationError("--near-misses", "'" + item + "' is not a number of seconds in [-5, 5]");
+           o.stream.near_negative_offsets_s.push_back(d);
+         }
+       },
+       "--spot: s from each action point where training windows are garbage too, comma-separated "
+       "(default -0.7,-0.5,0.5,0.7), or none")
+      ->type_name("S,S,...|none");
 }
 
 void add_common(CLI::App* c, GestureOptions& o, bool model_options) {

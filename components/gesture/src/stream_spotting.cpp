@@ -14,6 +14,8 @@ namespace {
 
 std::int64_t ns(double s) { return static_cast<std::int64_t>(s * 1e9); }
 
+constexpr double kNearOther = 0.3;  // s: a near-miss garbage window this close to an annotation is dropped
+
 // The frames of the window that ends at frame `end` (inclusive): those newer than stamp[end] - window.
 Sequence window_at(const AnnotatedStream& s, std::size_t end, double window_s) {
   const auto from = s.stamps[end] - ns(window_s);
@@ -34,7 +36,7 @@ bool frame_at(const AnnotatedStream& s, std::int64_t t, std::size_t& out) {
 
 nlohmann::json StreamSpotOptions::to_json() const {
   return {{"window_s", window_s},         {"positive_offsets_s", positive_offsets_s}, {"negative_gap_s", negative_gap_s},
-          {"negative_step_s", negative_step_s}, {"step_s", step_s},                    {"confirm", confirm},
+          {"negative_step_s", negative_step_s}, {"near_negative_offsets_s", near_negative_offsets_s}, {"step_s", step_s},                    {"confirm", confirm},
           {"refractory_s", refractory_s}, {"slack_s", slack_s}, {"model", model}, {"knn_k", knn_k},
           {"knn_samples", knn_samples}};
 }
@@ -91,6 +93,13 @@ std::vector<Clip> stream_windows(const AnnotatedStream& s, const ClassMap& map, 
     for (const auto& a : s.annotations) near = near || (t > a.start_ns - ns(o.negative_gap_s) && t < a.end_ns + ns(o.negative_gap_s));
     if (!near) add(t, map.garbage);
   }
+  for (const auto& a : s.annotations)
+    for (double d : o.near_negative_offsets_s) {
+      const auto t = a.end_ns + ns(d);
+      bool other = false;  // another gesture's action point (or range) this close: not garbage
+      for (const auto& b : s.annotations) other = other || (&b != &a && t > b.start_ns - ns(kNearOther) && t < b.end_ns + ns(kNearOther));
+      if (!other) add(t, map.garbage);
+    }
   return clips;
 }
 
@@ -306,6 +315,8 @@ StreamSpotter StreamSpotter::load(const std::string& path) {
     s.options_.positive_offsets_s = o.at("positive_offsets_s").get<std::vector<double>>();
     s.options_.negative_gap_s = o.at("negative_gap_s").get<double>();
     s.options_.negative_step_s = o.at("negative_step_s").get<double>();
+    // Spotters saved before near misses were trained without them.
+    s.options_.near_negative_offsets_s = o.value("near_negative_offsets_s", std::vector<double>{});
     s.options_.step_s = o.at("step_s").get<double>();
     s.options_.confirm = o.at("confirm").get<int>();
     s.options_.refractory_s = o.at("refractory_s").get<double>();

@@ -42,6 +42,12 @@ struct StreamSpotOptions {
   std::vector<double> positive_offsets_s{-0.1, 0.0, 0.1, 0.2};  // training windows end this far from an action point
   double negative_gap_s = 0.8;                              // garbage windows end at least this far from every one
   double negative_step_s = 0.3;                             // ... one every this long
+  // Garbage windows also end this far from each action point (a range's
+  // end), unless another is within 0.3 s: a window of most of the gesture,
+  // ending too early or too late, is not the gesture yet. Without them the
+  // spotter fired up to 0.9 s before the action point (MSRC-12: macro F1
+  // 0.653 without, docs/experiments/2026-12-06-msrc12-near-misses.md).
+  std::vector<double> near_negative_offsets_s{-0.7, -0.5, 0.5, 0.7};
   double step_s = 0.1;                                      // spotting: a window every this long
   int confirm = 2;                                          // the same gesture class wins this many windows in a row
   double refractory_s = 1.5;                                // then no event of that class for this long
