@@ -38,6 +38,14 @@ set -e
 grep -q "need wrist joints" "$WORK/run_hands.err" || fail "run gesture with a hands model: $(cat "$WORK/run_hands.err")"
 ok "the gesture component refuses a hands model: $(grep -m1 'wrist' "$WORK/run_hands.err")"
 
+# With no model option, train takes the class set's best measured configuration (wrists here: hands 3/2/diag) and says so.
+"$S" gesture train "$WORK/train" --json >"$WORK/train_default.json" 2>"$WORK/train_default.err" \
+  || fail "gesture train with defaults: $(cat "$WORK/train_default.err")"
+json_check "$WORK/train_default.json" 'd["clips"] == 144 and d["config"]["features"] == "hands" and d["config"]["states"] == 3 and d["config"]["mixtures"] == 2 and d["config"]["covariance"] == "diag"'
+grep -q "the best measured for these classes (two-class 98.8 %" "$WORK/train_default.err" || fail "train's defaults unannounced: $(cat "$WORK/train_default.err")"
+grep -q "for a live model give --features thesis8" "$WORK/train_default.err" || fail "train's defaults: no word on the live component: $(cat "$WORK/train_default.err")"
+ok "train with no model option: $(grep -m1 '^model:' "$WORK/train_default.err" | cut -c1-90)"
+
 # Five classes, stratified 2-fold, on the labelled clips only.
 mkdir -p "$WORK/five"
 for a in Point-at-the-camera Push-an-imaginary-button Walk-in-place Raise-your-hand- Wave-your-hand-; do ln -s "$KG"/*"$a"* "$WORK/five/"; done
@@ -50,9 +58,12 @@ ok "five-class 2-fold cross-validation: confusion matrix over 50 clips, SVG writ
 "$S" gesture cv "$WORK/five" --classes five-class --split kfold --folds 2 --features arm --states 3 --covariance diag \
   --init kmeans --restarts 4 --json >"$WORK/cv_km.json" 2>"$WORK/cv.err" || fail "gesture cv --init kmeans: $(cat "$WORK/cv.err")"
 json_check "$WORK/cv_km.json" 'd["config"]["init"] == "kmeans" and d["config"]["restarts"] == 4 and sum(map(sum, d["metrics"]["confusion"])) == 50 and d["metrics"]["accuracy"] > 0.4'
+"$S" gesture cv "$WORK/five" --classes five-class --split kfold --folds 2 --json >"$WORK/cv_default.json" 2>"$WORK/cv.err" \
+  || fail "gesture cv five-class with defaults: $(cat "$WORK/cv.err")"
+json_check "$WORK/cv_default.json" 'd["config"]["features"] == "arm" and d["config"]["init"] == "kmeans" and d["config"]["restarts"] == 16 and d["config"]["covariance"] == "diag" and sum(map(sum, d["metrics"]["confusion"])) == 50'
 "$S" gesture cv "$WORK/five" --classes five-class --init random 2>"$WORK/bad.err" && fail "--init random was accepted"
 grep -q "init" "$WORK/bad.err" || fail "--init random: $(cat "$WORK/bad.err")"
-ok "five-class with k-means initialisation and restarts; an unknown --init is refused"
+ok "five-class with k-means initialisation and restarts (the default with no model option); an unknown --init is refused"
 
 # A small sweep (2 states x 2 covariances, 1 mixture; under a second): every configuration is reported, and the
 # winner (config and metrics) is the sweep's best by accuracy, then the first class's F1.

@@ -290,9 +290,9 @@ TEST(DepthTracker, HandsHeldOutTowardsTheSensorAreThePersons) {
   // hidden: without the free-space term the fit holds them out in the air in
   // front of the trunk, where the sensor would have seen them.
   const auto off_person = [&](const std::vector<skeleton::Skeleton>& people) {
-    int off = 0;
-    for (const auto& j : people.at(0).joints) off += j.confidence > 0 && !depth_tracker::on_surface(img, j.position);
-    return off;
+    int n = 0;
+    for (const auto& j : people.at(0).joints) n += j.confidence > 0 && !depth_tracker::on_surface(img, j.position);
+    return n;
   };
   EXPECT_EQ(off_person(out), 0);
   depth_tracker::TrackerOptions no_free_space;

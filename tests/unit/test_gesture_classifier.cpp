@@ -12,6 +12,7 @@
 #include <fstream>
 #include <random>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 
 #include "skelgraph/gesture/classifier.hpp"
@@ -451,16 +452,53 @@ TEST(KinderGator, LeaveSubjectOutTwoClass) {
 }
 
 // With the hand segment (Kinect v1's wrist and hand), pointing is told apart
-// from signal-to-stop and push-a-button. 3 states, 2 mixtures, diagonal: the
-// winner of `gesture cv --features hands --sweep --sweep-mixtures 1 2`.
+// from signal-to-stop and push-a-button. The configuration is what `gesture
+// train` and `cv` take with no model option (hands, 3 states, 2 mixtures,
+// diagonal: the winner of `gesture cv --features hands --sweep --sweep-mixtures 1 2`).
 TEST(KinderGator, LeaveSubjectOutTwoClassWithHands) {
-  const auto m = kinder_gator_two_class(FeatureSet::Hands, [](ClassifierOptions& o) {
-    o.hmm.states = 3;
-    o.hmm.mixtures = 2;
-    o.hmm.covariance = Covariance::Diagonal;
-  });
+  DatasetOptions d;
+  d.format = skelgraph::playback::Format::KinderGator;
+  ASSERT_TRUE(inputs_have_wrists({kinder_gator()}, d));
+  const auto best = best_configuration("two-class", true);
+  ASSERT_EQ(best.features, FeatureSet::Hands);
+  const auto m = kinder_gator_two_class(best.features, [&](ClassifierOptions& o) { best.apply(o); });
   EXPECT_GE(m.accuracy, 0.98);
   EXPECT_GE(m.f1[0], 0.9);
+}
+
+// Without wrists the default falls back to what runs on 15 joints: the same
+// Kinder-Gator file written as a generic CSV without its extra joints.
+TEST(KinderGator, TheDefaultConfigurationNeedsWristsOnlyWhereTheInputsHaveThem) {
+  namespace pb = skelgraph::playback;
+  fs::path file;
+  for (const auto& e : fs::directory_iterator(kinder_gator()))
+    if (e.path().extension() == ".csv") { file = e.path(); break; }
+  ASSERT_FALSE(file.empty()) << kinder_gator() << " has no clips: tests read ../shared/data (or SKELGRAPH_DATA_DIR)";
+  auto rec = pb::read_recording(pb::Format::KinderGator, file.string());
+  ASSERT_FALSE(rec.extra_joints.empty());
+  const auto csv = [](const pb::Recording& r) {
+    std::ostringstream os;
+    pb::write_generic_csv(r, os);
+    return os.str();
+  };
+  const auto with = write_temp("with_wrists.csv", csv(rec));
+  rec.extra_joints.clear();
+  const auto without = write_temp("without_wrists.csv", csv(rec));
+  const auto empty = write_temp("empty.csv", "");
+  DatasetOptions d;
+  d.format = pb::Format::Generic;
+  EXPECT_TRUE(inputs_have_wrists({with}, d));
+  EXPECT_FALSE(inputs_have_wrists({without}, d));
+  EXPECT_TRUE(inputs_have_wrists({empty, with}, d));  // a file that does not read does not decide
+  EXPECT_FALSE(inputs_have_wrists({empty, fs::path(empty).replace_extension("missing.csv").string()}, d));
+  for (const auto& f : {with, without, empty}) fs::remove(f);
+  for (const char* set : {"two-class", "five-class", "robot"}) {
+    EXPECT_FALSE(needs_wrists(best_configuration(set, false).features)) << set;
+    EXPECT_TRUE(needs_wrists(best_configuration(set, true).features)) << set;
+  }
+  const auto five = best_configuration("five-class", true);
+  EXPECT_EQ(five.features, FeatureSet::Arm);
+  EXPECT_EQ(five.init, Init::KMeans);
 }
 
 // Annotated streams: two gestures, each a bump of its own feature that peaks

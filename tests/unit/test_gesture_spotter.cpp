@@ -453,6 +453,8 @@ TEST(BuiltinModel, TheOperatingCurveIsSpottingAgainAtEachPoint) {
       EXPECT_LE(curve[k].recall, curve[k - 1].recall) << k;
       EXPECT_LE(curve[k].false_per_hour, curve[k - 1].false_per_hour) << k;
     }
-    if (k >= 3) EXPECT_LE(curve[k].recall, curve[k - 3].recall) << k;
+    if (k >= 3) {
+      EXPECT_LE(curve[k].recall, curve[k - 3].recall) << k;
+    }
   }
 }

@@ -65,8 +65,18 @@ void add_common(CLI::App* c, GestureOptions& o, bool model_options) {
   add_model_options(c, o);
 }
 
+// train and cv take the class set's best measured configuration unless one of these is given.
+bool any_model_option(CLI::App* c) {
+  for (const char* name : {"--features", "--states", "--mixtures", "--covariance", "--init", "--restarts", "--hands"})
+    if (c->count(name) > 0) return true;
+  return false;
+}
+
 void add_model_options(CLI::App* c, GestureOptions& o) {
-  c->add_option("--features", o.features, "feature set: thesis8 (default; the thesis's 8), extended, body, hands, arm (hands and arm need wrists: Kinect v1/v2 recordings)")
+  c->add_option("--features", o.features, "feature set: thesis8 (the thesis's 8), extended, body, hands, arm (hands and arm need wrists: Kinect v1/v2 "
+                "recordings). Default thesis8, 7 states, 1 mixture, full, segments x 1; train and cv on clips without any of "
+                "--features --states --mixtures --covariance --init --restarts --hands (nor --sweep): the class set's best measured (two-class, "
+                "robot: hands 3/2/diag; five-class: arm 3/1/diag, kmeans x 16; without wrists the default)")
       ->check(CLI::IsMember({"body", "thesis8", "extended", "hands", "arm"}));
   c->add_option("--states", o.states, "HMM states (default 7)")->check(CLI::Range(1, 50));
   c->add_option("--mixtures", o.mixtures, "Gaussians per state (default 1)")->check(CLI::Range(1, 20));
@@ -147,6 +157,7 @@ void add_gesture_command(CLI::App& app, GlobalOptions&, Action& run) {
                      "on all of them, for `gesture spot --model`; --features defaults to body here");
   t->add_option("--out", o->out, "write the classifier (JSON)");
   t->callback([o, t, &run] {
+    o->best_configuration = !o->spot_streams && !any_model_option(t);
     if (o->spot_streams && t->get_option("--features")->count() == 0) o->features = "body";
     run = [o] { return gesture_train(*o); };
   });
@@ -179,6 +190,7 @@ void add_gesture_command(CLI::App& app, GlobalOptions&, Action& run) {
       ->check(CLI::IsMember({"segments", "kmeans"}));
   cv->callback([o, cv, &run] {
     // --spot's defaults are its best measured configuration (docs/experiments/2026-12-04-msrc12-spotting.md).
+    o->best_configuration = !o->spot_streams && !o->sweep && !any_model_option(cv);
     if (o->spot_streams && cv->get_option("--features")->count() == 0) o->features = "body";
     run = [o] { return gesture_cv(*o); };
   });

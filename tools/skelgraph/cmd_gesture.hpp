@@ -39,6 +39,7 @@ struct GestureOptions {
   std::uint64_t seed = 1;
   int threads = 2;
   bool json = false;
+  bool best_configuration = false;  // train, cv on clips: no model option given, so the class set's best measured
   std::string on_error = "stop";  // a bad line in an input: stop (the file is bad) or skip it
   // train / classify
   std::string out, model;
@@ -76,6 +77,10 @@ int gesture_spot_model(const GestureOptions& o);
 int gesture_classify(const GestureOptions& o);
 int gesture_features(const GestureOptions& o);
 int gesture_sim(const GestureOptions& o);
+
+// classifier_options, with the class set's best measured configuration
+// (gesture::best_configuration) when `best_configuration` is set; says which on stderr.
+ClassifierOptions chosen_classifier_options(const GestureOptions& o);
 
 // Shared by them (cmd_gesture_clips.cpp, cmd_gesture_cv.cpp, cmd_gesture_streams.cpp).
 ClassMap class_map(const std::string& c);

@@ -56,6 +56,25 @@ ClassifierOptions classifier_options(const GestureOptions& o) {
   return c;
 }
 
+ClassifierOptions chosen_classifier_options(const GestureOptions& o) {
+  auto c = classifier_options(o);
+  if (!o.best_configuration) return c;
+  DatasetOptions d;
+  d.format = *playback::format_from_name(o.format);
+  d.read = read_options(o);
+  const auto best = best_configuration(o.classes, inputs_have_wrists(o.inputs, d));
+  best.apply(c);
+  std::fprintf(stderr, "model: %s features, %d states, %d mixtures, %s covariance, %s initialisation x %d, the best measured for "
+               "these classes (%s); any model option (--features, --states, ...) leaves the choice to you%s\n",
+               feature_set_name(c.features.set), c.hmm.states, c.hmm.mixtures,
+               c.hmm.covariance == Covariance::Full ? "full" : "diag", c.hmm.init == Init::KMeans ? "kmeans" : "segments",
+               c.hmm.restarts, best.measured.c_str(),
+               needs_wrists(c.features.set) ? "; it needs wrists, which the live gesture component does not have: for a live model "
+                                              "give --features thesis8"
+                                            : "");
+  return c;
+}
+
 playback::ReadOptions read_options(const GestureOptions& o) {
   playback::ReadOptions r;
   r.on_error = o.on_error == "skip" ? playback::ReadOptions::OnError::Skip : playback::ReadOptions::OnError::Stop;
@@ -109,7 +128,7 @@ nlohmann::json config_json(const ClassifierOptions& c) {
 int gesture_train(const GestureOptions& o) {
   if (o.spot_streams) return gesture_train_streams(o);
   const auto map = class_map(o.classes);
-  const auto c = classifier_options(o);
+  const auto c = chosen_classifier_options(o);
   BadInputs bad;
   const auto clips = load(o, map, c, bad);
   std::fprintf(stderr, "training %zu models ...\n", map.classes.size());

@@ -57,7 +57,7 @@ CvOptions cv_options(const GestureOptions& o) {
 int gesture_cv(const GestureOptions& o) {
   if (o.spot_streams) return gesture_cv_streams(o);
   const auto map = class_map(o.classes);
-  const auto base = classifier_options(o);
+  const auto base = chosen_classifier_options(o);
   BadInputs bad;
   const auto clips = load(o, map, base, bad);
   std::vector<ClassifierOptions> configs;

@@ -101,4 +101,52 @@ std::vector<Clip> load_clips(const std::vector<std::string>& paths, const ClassM
   return clips;
 }
 
+bool inputs_have_wrists(const std::vector<std::string>& paths, const DatasetOptions& o) {
+  for (const auto& file : expand_paths(paths)) {
+    try {
+      const auto rec = playback::read_recording(o.format, file, o.read);
+      if (rec.frames.empty()) continue;
+      return !wrists_of(rec).empty();
+    } catch (const playback::DataError&) {
+      // a bad file: the next one decides, and the load reports this one
+    }
+  }
+  return false;
+}
+
+void ModelConfiguration::apply(ClassifierOptions& c) const {
+  c.features.set = features;
+  c.hmm.states = states;
+  c.hmm.mixtures = mixtures;
+  c.hmm.covariance = covariance;
+  c.hmm.init = init;
+  c.hmm.restarts = restarts;
+}
+
+ModelConfiguration best_configuration(const std::string& class_set, bool wrists) {
+  ModelConfiguration m;  // thesis8, 7 states, full: the best without wrists
+  if (!wrists) {
+    m.measured = "two-class 95.6 % leave-subject-out, the best measured without wrists";
+    return m;
+  }
+  if (class_set == "five-class") {
+    m.features = FeatureSet::Arm;
+    m.states = 3;
+    m.mixtures = 1;
+    m.covariance = Covariance::Diagonal;
+    m.init = Init::KMeans;
+    m.restarts = 16;
+    m.measured = "five-class 92.0 % leave-subject-out";
+    return m;
+  }
+  m.features = FeatureSet::Hands;
+  m.states = 3;
+  m.mixtures = 2;
+  m.covariance = Covariance::Diagonal;
+  m.measured = class_set == "robot"       ? "robot 81.2 % leave-subject-out"
+               : class_set == "two-class" ? "two-class 98.8 % leave-subject-out, point F1 0.91"
+                                          : "two-class's best (98.8 %); not measured for this class set";
+  return m;
+}
+
 }  // namespace skelgraph::gesture

@@ -43,4 +43,26 @@ std::vector<Clip> load_clips(const std::vector<std::string>& paths, const ClassM
 // The files `paths` name: files as given, directories expanded to their *.csv files.
 std::vector<std::string> expand_paths(const std::vector<std::string>& paths);
 
+// Whether the inputs carry wrist joints (what the hands and arm features
+// need): the first file that reads decides; false when none reads.
+bool inputs_have_wrists(const std::vector<std::string>& paths, const DatasetOptions& options);
+
+// The best configuration measured for a class set (leave-subject-out on
+// Kinder-Gator's ten adults), which `gesture train` and `gesture cv` use
+// when no model option is given. With wrists: two-class hands 3 states 2
+// mixtures diagonal (98.8 %), five-class arm 3/1 diagonal from k-means with
+// 16 restarts (92.0 %), robot as two-class (81.2 %), a class file as
+// two-class (not measured for it); without wrists thesis8 7 states full
+// (two-class 95.6 %, the best measured without them).
+struct ModelConfiguration {
+  FeatureSet features = FeatureSet::Thesis8;
+  int states = 7, mixtures = 1;
+  Covariance covariance = Covariance::Full;
+  Init init = Init::Segments;
+  int restarts = 1;
+  std::string measured;  // what it reached, for the user
+  void apply(ClassifierOptions& c) const;
+};
+ModelConfiguration best_configuration(const std::string& class_set, bool wrists);
+
 }  // namespace skelgraph::gesture
