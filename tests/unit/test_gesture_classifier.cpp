@@ -551,6 +551,15 @@ TEST(StreamSpotting, NearMissesAreGarbageUnlessAnotherGestureIsThere) {
   EXPECT_EQ(garbage(with) - garbage(without), 11 * 4 + 2 + 2);  // the other 11, the first's two before, the second's two after
 }
 
+TEST(StreamSpotting, NearMissOffsetsFromText) {
+  EXPECT_EQ(parse_near_misses("-0.7,-0.5,0.5,0.7"), (std::vector<double>{-0.7, -0.5, 0.5, 0.7}));
+  EXPECT_TRUE(parse_near_misses("none").empty());
+  EXPECT_EQ(error_of([] { parse_near_misses("0.5,x"); }), "'x' is not a number of seconds in [-5, 5]");
+  EXPECT_EQ(error_of([] { parse_near_misses("0.5s"); }), "'0.5s' is not a number of seconds in [-5, 5]");
+  EXPECT_EQ(error_of([] { parse_near_misses("6"); }), "'6' is not a number of seconds in [-5, 5]");
+  EXPECT_EQ(error_of([] { parse_near_misses("0.5,,0.7"); }), "'' is not a number of seconds in [-5, 5]");
+}
+
 TEST(StreamSpotting, FindsEachGestureNearItsActionPoint) {
   std::vector<AnnotatedStream> streams;
   for (int subject = 0; subject < 3; ++subject) streams.push_back(synthetic_stream("s" + std::to_string(subject), 11 + subject));

@@ -3,7 +3,6 @@
 // libraries.
 
 #include <memory>
-#include <sstream>
 
 #include "cmd_gesture.hpp"
 #include "skelgraph/gesture/builtin_models.hpp"
@@ -31,20 +30,10 @@ void add_stream_options(CLI::App* c, GestureOptions& o, const std::string& what)
   c->add_option_function<std::string>(
        "--near-misses",
        [&o](const std::string& v) {
-         o.stream.near_negative_offsets_s.clear();
-         if (v == "none") return;
-         std::stringstream in(v);
-         for (std::string item; std::getline(in, item, ',');) {
-           std::size_t used = 0;
-           double d = 0;
-           try {
-             d = std::stod(item, &used);
-           } catch (const std::exception&) {
-             used = 0;
-           }
-           if (used == 0 || used != item.size() || !(d >= -5.0 && d <= 5.0))
-             throw CLI::ValidationError("--near-misses", "'" + item + "' is not a number of seconds in [-5, 5]");
-           o.stream.near_negative_offsets_s.push_back(d);
+         try {
+           o.stream.near_negative_offsets_s = parse_near_misses(v);
+         } catch (const std::invalid_argument& e) {
+           throw CLI::ValidationError("--near-misses", e.what());
          }
        },
        "--spot: s from each action point where training windows are garbage too, comma-separated "

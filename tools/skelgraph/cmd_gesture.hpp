@@ -89,7 +89,6 @@ playback::ReadOptions read_options(const GestureOptions& o);
 // The clips of the inputs; a bad file is reported in `bad` and left out.
 std::vector<Clip> load(const GestureOptions& o, const ClassMap& map, const ClassifierOptions& c, BadInputs& bad);
 std::string pct(double v);
-const char* init_name(Init i);
 nlohmann::json config_json(const ClassifierOptions& c);
 CvOptions cv_options(const GestureOptions& o);
 

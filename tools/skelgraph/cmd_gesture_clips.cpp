@@ -64,14 +64,10 @@ ClassifierOptions chosen_classifier_options(const GestureOptions& o) {
   d.read = read_options(o);
   const auto best = best_configuration(o.classes, inputs_have_wrists(o.inputs, d));
   best.apply(c);
-  std::fprintf(stderr, "model: %s features, %d states, %d mixtures, %s covariance, %s initialisation x %d, the best measured for "
-               "these classes (%s); any model option (--features, --states, ...) leaves the choice to you%s\n",
-               feature_set_name(c.features.set), c.hmm.states, c.hmm.mixtures,
-               c.hmm.covariance == Covariance::Full ? "full" : "diag", c.hmm.init == Init::KMeans ? "kmeans" : "segments",
-               c.hmm.restarts, best.measured.c_str(),
-               needs_wrists(c.features.set) ? "; it needs wrists, which the live gesture component does not have: for a live model "
-                                              "give --features thesis8"
-                                            : "");
+  std::fprintf(stderr, "model: %s, the best measured for these classes (%s); any model option (--features, --states, ...) leaves "
+               "the choice to you%s\n", best.describe().c_str(), best.measured.c_str(),
+               needs_wrists(best.features) ? "; it needs wrists, which the live gesture component does not have: for a live "
+                                             "model give --features thesis8" : "");
   return c;
 }
 
@@ -108,8 +104,6 @@ std::string pct(double v) {
   std::snprintf(b, sizeof b, "%.1f %%", 100 * v);
   return b;
 }
-
-const char* init_name(Init i) { return i == Init::KMeans ? "kmeans" : "segments"; }
 
 nlohmann::json config_json(const ClassifierOptions& c) {
   return {{"features", feature_set_name(c.features.set)},

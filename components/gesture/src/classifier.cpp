@@ -134,6 +134,8 @@ std::optional<Hands> hands_from_name(const std::string& name) {
   return std::nullopt;
 }
 
+const char* init_name(Init i) { return i == Init::KMeans ? "kmeans" : "segments"; }
+
 const char* hands_name(Hands h) {
   switch (h) {
     case Hands::Canonical: return "canonical";

@@ -123,6 +123,12 @@ void ModelConfiguration::apply(ClassifierOptions& c) const {
   c.hmm.restarts = restarts;
 }
 
+std::string ModelConfiguration::describe() const {
+  return std::string(feature_set_name(features)) + " features, " + std::to_string(states) + " states, " + std::to_string(mixtures) +
+         " mixtures, " + (covariance == Covariance::Full ? "full" : "diag") + " covariance, " + init_name(init) + " x " +
+         std::to_string(restarts);
+}
+
 ModelConfiguration best_configuration(const std::string& class_set, bool wrists) {
   ModelConfiguration m;  // thesis8, 7 states, full: the best without wrists
   if (!wrists) {

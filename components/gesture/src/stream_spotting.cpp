@@ -5,6 +5,8 @@
 #include <fstream>
 #include <map>
 #include <set>
+#include <sstream>
+#include <stdexcept>
 
 #include "skelgraph/gesture/dataset.hpp"
 
@@ -55,6 +57,25 @@ AnnotatedStream annotated_stream(const playback::Recording& rec, const FeatureOp
   s.x = recording_features(rec, features).x;
   s.annotations = std::move(annotations);
   return s;
+}
+
+std::vector<double> parse_near_misses(const std::string& text) {
+  std::vector<double> out;
+  if (text == "none") return out;
+  std::stringstream in(text);
+  for (std::string item; std::getline(in, item, ',');) {
+    std::size_t used = 0;
+    double d = 0;
+    try {
+      d = std::stod(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != item.size() || !(d >= -5.0 && d <= 5.0))
+      throw std::invalid_argument("'" + item + "' is not a number of seconds in [-5, 5]");
+    out.push_back(d);
+  }
+  return out;
 }
 
 ClassMap stream_class_map(const std::vector<AnnotatedStream>& streams) {

@@ -41,6 +41,7 @@ struct Clip {
 enum class Hands { Canonical, Augment, AsIs };
 std::optional<Hands> hands_from_name(const std::string& name);  // "canonical", "augment", "as-is"
 const char* hands_name(Hands h);
+const char* init_name(Init i);  // "kmeans", "segments"
 
 struct ClassifierOptions {
   TrainOptions hmm;                  // states, mixtures, covariance for every class model

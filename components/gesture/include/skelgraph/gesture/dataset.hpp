@@ -62,6 +62,7 @@ struct ModelConfiguration {
   int restarts = 1;
   std::string measured;  // what it reached, for the user
   void apply(ClassifierOptions& c) const;
+  std::string describe() const;  // "hands features, 3 states, 2 mixtures, diag covariance, segments x 1"
 };
 ModelConfiguration best_configuration(const std::string& class_set, bool wrists);
 

@@ -82,6 +82,10 @@ class WindowKnn {
   std::vector<int> label_;
 };
 
+// `near_negative_offsets_s` from text: seconds, comma-separated, each in
+// [-5, 5], or "none" (empty). std::invalid_argument names the bad item.
+std::vector<double> parse_near_misses(const std::string& text);
+
 // The classes of the streams' annotations (sorted), with "none" as garbage.
 ClassMap stream_class_map(const std::vector<AnnotatedStream>& streams);
 // Training windows of one stream (Clip.subject = the stream's).
