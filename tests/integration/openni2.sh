@@ -72,7 +72,9 @@ json_check "$WORK/play1.json" 'abs(d["duration_s"] - '"$frames"' / 30.0) < 1.5'
 ok "played back $frames frames fast and in $(json_get "$WORK/play1.json" 'round(d["duration_s"], 1)') s at speed 1"
 
 # 3b. A paused player delivers exactly the frames a step asks for, holds, then plays on at a new speed.
-"$SKELGRAPH" run openni2 --name player1 -p uri="$WORK/mended.oni" -p paused=true --duration 40 --json \
+# It ends when the file is played (the resume below); --duration only bounds it (40 s was too little beside two
+# busy loops, where finding it took most of that: 'no player named player1' at the last command).
+"$SKELGRAPH" run openni2 --name player1 -p uri="$WORK/mended.oni" -p paused=true --duration 150 --json \
   >"$WORK/step.json" 2>"$WORK/step.err" &
 player=$!
 "$SKELGRAPH" player state --target player1 --json --timeout 30 >"$WORK/st0.json" || fail "player state: $(cat "$WORK/step.err")"
