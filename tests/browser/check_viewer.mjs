@@ -67,15 +67,18 @@ try {
     return d;
   };
 
-  // Layer toggle: hide the first sensor's skeleton.
+  // Layer toggle: hide the first sensor's skeleton; the other streams drawn before stay drawn.
+  // (Compared by stream, not by count: on a busy machine a stream missing from one frame is back in the next.)
   const before = (await stats()).drawn;
   const hidden = before.list.find((s) => s.kind === 'raw');
   if (hidden) {
     const has = (d) => d.list.some((s) => s.stream === hidden.stream);
+    const others = [...new Set(before.list.map((s) => s.stream))].filter((st) => st !== hidden.stream);
+    const keepsOthers = (d) => others.every((st) => d.list.some((s) => s.stream === st));
     await page.uncheck(`input[data-layer="${hidden.stream}"]`);
-    const after = await drawnUntil((d) => !has(d));
-    out.toggle = { stream: hidden.stream, before: before.skeletons,
-                   after: after.skeletons, still_drawn: has(after) };
+    const after = await drawnUntil((d) => !has(d) && keepsOthers(d));
+    out.toggle = { stream: hidden.stream, before: before.skeletons, others,
+                   after: after.skeletons, still_drawn: has(after), others_kept: keepsOthers(after) };
     await page.check(`input[data-layer="${hidden.stream}"]`);
     out.toggle.restored = has(await drawnUntil(has));
   }
