@@ -274,6 +274,43 @@ TEST(SafetyRun, AWorkerWatchedFromFourSidesIsNeverTooCloseToAMovingArm) {
   EXPECT_LT(r.min_true_separation_m, 0.5);
 }
 
+// Following a hand at the README's 1.2 m standoff: the arm is allowed to
+// move, the tool never leaves the workspace once in it, it stays near where
+// the true hand puts it while the hand is slow, and it lags by the trackers'
+// delay and the arm's: more than 50 ms, well under a second.
+TEST(SafetyRun, FollowingAHandStaysInTheWorkspaceAndLagsByTheDelays) {
+  auto o = robot_cell(2);
+  o.follow.emplace();
+  o.follow->standoff_m = 1.2;
+  const auto r = skelgraph::eval::run_safety(o);
+  ASSERT_GT(r.follow_moving_steps, 50u);
+  EXPECT_EQ(r.follow_outside_steps, 0u);
+  ASSERT_EQ(r.follow_hand_speed.size(), r.follow_error_m.size());
+  const auto slow = r.follow_error_at_most(0.5);
+  ASSERT_GT(slow.size(), 20u);
+  EXPECT_LT(skelgraph::eval::quantile(slow, 0.5), 0.3);
+  EXPECT_GT(r.follow_lag_ms(), 50.0);
+  EXPECT_LT(r.follow_lag_ms(), 1000.0);
+}
+
+// The lag is the delay of least mean distance; runs combine bin by bin; the
+// slow-hand errors are those at or below the speed (an unknown speed is fast).
+TEST(SafetyRun, TheFollowLagIsTheDelayOfLeastMeanDistance) {
+  skelgraph::eval::SafetyRunResult r;
+  r.decision_period_s = 0.01;
+  r.follow_lag_sum_m = {3.0, 1.0, 2.0};  // means 0.3, 0.1, 0.5 m
+  r.follow_lag_n = {10, 10, 4};
+  EXPECT_DOUBLE_EQ(r.follow_lag_ms(), 10.0);
+  r.follow_error_m = {0.1, 0.2, 0.3};
+  r.follow_hand_speed = {0.2, 0.9, std::numeric_limits<double>::infinity()};
+  EXPECT_EQ(r.follow_error_at_most(0.5), (std::vector<double>{0.1}));
+  const auto all = skelgraph::eval::combine({r, r});
+  EXPECT_EQ(all.follow_lag_n, (std::vector<std::uint64_t>{20, 20, 8}));
+  EXPECT_DOUBLE_EQ(all.follow_lag_ms(), 10.0);
+  EXPECT_EQ(all.follow_error_at_most(0.5), (std::vector<double>{0.1, 0.1}));
+  EXPECT_EQ(skelgraph::eval::SafetyRunResult{}.follow_lag_ms(), 0.0);
+}
+
 // The judge can fail: a monitor whose commands take a second to act, with
 // neither the position uncertainty nor the release hold, lets the arm move
 // while the worker is too close, and its stops come late.

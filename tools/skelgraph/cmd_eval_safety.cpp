@@ -37,7 +37,11 @@ struct SafetyOptions {
   bool json = false;
 };
 
+// The hand speed for following: at most 0.5 m/s.
+constexpr double kSlowHand = 0.5;
+
 nlohmann::json run_json(const eval::SafetyRunResult& r) {
+  const auto slow = r.follow_error_at_most(kSlowHand);
   return {{"seconds", r.seconds},
           {"steps", r.steps},
           {"steps_by_state", r.steps_by_state},
@@ -54,7 +58,13 @@ nlohmann::json run_json(const eval::SafetyRunResult& r) {
           {"follow",
            {{"steps", r.follow_steps},
             {"moving_steps", r.follow_moving_steps},
-            {"error_m", {{"p50", eval::quantile(r.follow_error_m, 0.5)}, {"p95", eval::quantile(r.follow_error_m, 0.95)}}}}},
+            {"error_m", {{"p50", eval::quantile(r.follow_error_m, 0.5)}, {"p95", eval::quantile(r.follow_error_m, 0.95)}}},
+            {"slow_hand_error_m", {{"hand_at_most_m_s", kSlowHand},
+                                   {"steps", slow.size()},
+                                   {"p50", eval::quantile(slow, 0.5)},
+                                   {"p95", eval::quantile(slow, 0.95)}}},
+            {"lag_ms", r.follow_lag_ms()},
+            {"outside_workspace_steps", r.follow_outside_steps}}},
           {"min_true_separation_m", std::isfinite(r.min_true_separation_m) ? nlohmann::json(r.min_true_separation_m) : nlohmann::json()}};
 }
 
@@ -145,6 +155,11 @@ int eval_safety(const SafetyOptions& o) {
                   all.steps ? 100.0 * static_cast<double>(all.follow_steps) / static_cast<double>(all.steps) : 0.0,
                   all.follow_steps ? 100.0 * static_cast<double>(all.follow_moving_steps) / static_cast<double>(all.follow_steps) : 0.0,
                   eval::quantile(all.follow_error_m, 0.5), eval::quantile(all.follow_error_m, 0.95));
+      const auto slow = all.follow_error_at_most(kSlowHand);
+      std::printf("follow: the hand at most %.1f m/s: median %.2f m, p95 %.2f m (%zu steps); lag %.0f ms; "
+                  "steps outside the workspace %llu\n",
+                  kSlowHand, eval::quantile(slow, 0.5), eval::quantile(slow, 0.95), slow.size(), all.follow_lag_ms(),
+                  static_cast<unsigned long long>(all.follow_outside_steps));
     }
   }
   return 0;

@@ -20,6 +20,28 @@ double quantile(std::vector<double> values, double q) {
   return values[k];
 }
 
+std::vector<double> SafetyRunResult::follow_error_at_most(double hand_speed) const {
+  std::vector<double> out;
+  for (std::size_t i = 0; i < follow_error_m.size() && i < follow_hand_speed.size(); ++i) {
+    if (follow_hand_speed[i] <= hand_speed) out.push_back(follow_error_m[i]);
+  }
+  return out;
+}
+
+double SafetyRunResult::follow_lag_ms() const {
+  std::size_t best = 0;
+  double best_mean = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < follow_lag_sum_m.size() && i < follow_lag_n.size(); ++i) {
+    if (follow_lag_n[i] == 0) continue;
+    const double mean = follow_lag_sum_m[i] / static_cast<double>(follow_lag_n[i]);
+    if (mean < best_mean) {
+      best_mean = mean;
+      best = i;
+    }
+  }
+  return static_cast<double>(best) * decision_period_s * 1e3;
+}
+
 namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
@@ -91,6 +113,14 @@ SafetyRunResult run_safety(const SafetyRunOptions& o) {
   if (o.follow) follower.emplace(*o.follow, o.world_from_base.translation());
   bool danger_before = false, waiting_for_stop = false;
   double danger_since = 0.0;
+  // Following: where the true hand would have put the tool, newest first (none
+  // while holding), for the lag; the true people a step before, for the hand's speed.
+  std::deque<std::optional<Eigen::Vector3d>> wants;
+  std::vector<skeleton::Skeleton> truths_before;
+  bool tool_was_inside = false;
+  r.decision_period_s = dt;
+  r.follow_lag_sum_m.assign(SafetyRunResult::kFollowLagSteps + 1, 0.0);
+  r.follow_lag_n.assign(SafetyRunResult::kFollowLagSteps + 1, 0);
 
   for (std::uint64_t k = 0; k < steps; ++k) {
     const double now = static_cast<double>(k) * dt;
@@ -214,6 +244,8 @@ SafetyRunResult run_safety(const SafetyRunOptions& o) {
     if (follower) {
       // The hand, as fused: where the tool goes; judged against where the true hand would send it.
       const auto f = follower->step(people, now_ns);
+      const auto truths = sim.truth_at(now);
+      std::optional<Eigen::Vector3d> want;
       if (f.hold) {
         arm.clear_target();
       } else {
@@ -221,24 +253,47 @@ SafetyRunResult run_safety(const SafetyRunOptions& o) {
         ++r.follow_steps;
         const auto& fused = *std::find_if(people.begin(), people.end(), [&](const auto& p) { return p.person_id == f.person; });
         const Eigen::Vector3d seen_hand = fused[o.follow->joint].position;
-        const auto truths = sim.truth_at(now);
         const skeleton::Skeleton* nearest_truth = nullptr;
         for (const auto& t : truths) {
           if (!nearest_truth || (t[o.follow->joint].position - seen_hand).norm() < ((*nearest_truth)[o.follow->joint].position - seen_hand).norm())
             nearest_truth = &t;
         }
-        if (nearest_truth && !stop) {
-          ++r.follow_moving_steps;
+        if (nearest_truth) {
           const Eigen::Vector3d hand = (*nearest_truth)[o.follow->joint].position;
           Eigen::Vector3d towards = o.world_from_base.translation() - hand;
           towards.y() = 0;
           if (towards.norm() < 1e-6) towards = Eigen::Vector3d::UnitZ();
-          const Eigen::Vector3d want = (hand + o.follow->standoff_m * towards.normalized())
-                                           .cwiseMax(o.follow->workspace.min())
-                                           .cwiseMin(o.follow->workspace.max());
-          r.follow_error_m.push_back((arm.tool_world() - want).norm());
+          want = (hand + o.follow->standoff_m * towards.normalized())
+                     .cwiseMax(o.follow->workspace.min())
+                     .cwiseMin(o.follow->workspace.max());
+          if (!stop) {
+            ++r.follow_moving_steps;
+            const Eigen::Vector3d tool = arm.tool_world();
+            r.follow_error_m.push_back((tool - *want).norm());
+            double speed = kInf;  // unknown (the person new this step): counted as fast
+            for (const auto& b : truths_before) {
+              if (b.person_id == nearest_truth->person_id) speed = (hand - b[o.follow->joint].position).norm() / dt;
+            }
+            r.follow_hand_speed.push_back(speed);
+            if (o.follow->workspace.exteriorDistance(tool) <= 1e-3) {
+              tool_was_inside = true;
+            } else if (tool_was_inside) {
+              ++r.follow_outside_steps;
+            }
+          }
         }
       }
+      wants.push_front(want);
+      if (wants.size() > static_cast<std::size_t>(SafetyRunResult::kFollowLagSteps) + 1) wants.pop_back();
+      if (want && !stop) {
+        const Eigen::Vector3d tool = arm.tool_world();
+        for (std::size_t i = 0; i < wants.size(); ++i) {
+          if (!wants[i]) continue;
+          r.follow_lag_sum_m[i] += (tool - *wants[i]).norm();
+          ++r.follow_lag_n[i];
+        }
+      }
+      truths_before = truths;
     } else {
       // The arm's own task.
       if ((arm.tool_world() - o.task[task_next]).norm() < 0.01) {
@@ -270,6 +325,17 @@ SafetyRunResult combine(const std::vector<SafetyRunResult>& runs) {
     all.follow_steps += r.follow_steps;
     all.follow_moving_steps += r.follow_moving_steps;
     join(all.follow_error_m, r.follow_error_m);
+    join(all.follow_hand_speed, r.follow_hand_speed);
+    all.follow_outside_steps += r.follow_outside_steps;
+    all.decision_period_s = std::max(all.decision_period_s, r.decision_period_s);
+    if (all.follow_lag_sum_m.size() < r.follow_lag_sum_m.size()) {
+      all.follow_lag_sum_m.resize(r.follow_lag_sum_m.size(), 0.0);
+      all.follow_lag_n.resize(r.follow_lag_sum_m.size(), 0);
+    }
+    for (std::size_t i = 0; i < r.follow_lag_sum_m.size(); ++i) {
+      all.follow_lag_sum_m[i] += r.follow_lag_sum_m[i];
+      all.follow_lag_n[i] += r.follow_lag_n[i];
+    }
     all.min_true_separation_m = std::min(all.min_true_separation_m, r.min_true_separation_m);
     join(all.time_to_stop_ms, r.time_to_stop_ms);
     join(all.reaction_ms, r.reaction_ms);

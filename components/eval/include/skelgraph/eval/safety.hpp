@@ -104,12 +104,30 @@ struct SafetyRunResult {
   // would put it (the same standoff and workspace), m.
   std::uint64_t follow_steps = 0, follow_moving_steps = 0;
   std::vector<double> follow_error_m;
+  std::vector<double> follow_hand_speed;  // the true hand's speed at each of those steps, m/s
+  // Moving steps with the tool outside the workspace box (by more than 1 mm)
+  // once it has been inside it; the target is 0.
+  std::uint64_t follow_outside_steps = 0;
+  // The lag: for a delay of i decision steps (i = 0 .. kFollowLagSteps), the
+  // tool's summed distance from where the true hand would have put it i steps
+  // before, over the moving steps that have both.
+  static constexpr int kFollowLagSteps = 100;
+  std::vector<double> follow_lag_sum_m;
+  std::vector<std::uint64_t> follow_lag_n;
+  double decision_period_s = 0;  // one decision step, s
   std::vector<SafetyTracePoint> trace;  // with trace_period_s
 
   // n steps as a share of all steps, % (0 without steps).
   double share_pct(std::uint64_t n) const {
     return steps > 0 ? 100.0 * static_cast<double>(n) / static_cast<double>(steps) : 0.0;
   }
+
+  // The tool's distance from the true hand's target at or below a hand speed
+  // (m/s), in the order of follow_error_m.
+  std::vector<double> follow_error_at_most(double hand_speed) const;
+  // The delay at which the tool is nearest where the true hand would have put
+  // it (least mean distance), ms; 0 without moving steps.
+  double follow_lag_ms() const;
 };
 
 // Several runs as one: counts and times added, the per-event lists joined (in
