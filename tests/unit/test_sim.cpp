@@ -17,7 +17,6 @@ using namespace skelgraph;
 using skeleton::JointId;
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 double bone(const skeleton::Skeleton& s, JointId a, JointId b) { return (s[a].position - s[b].position).norm(); }
 }  // namespace
 
@@ -92,11 +91,11 @@ TEST(SimScenario, ScriptsDoWhatTheirNamesSay) {
     max_h = std::max(max_h, a.pose.heading);
     if (a.phase == "turn_t_pose") {
       t_pose_seen = true;
-      EXPECT_NEAR(a.pose.left_arm.elevation, kPi / 2, 1e-9);
+      EXPECT_NEAR(a.pose.left_arm.elevation, EIGEN_PI / 2, 1e-9);
     }
   }
   EXPECT_TRUE(t_pose_seen);
-  EXPECT_NEAR(max_h - min_h, 4 * kPi, 1e-9);
+  EXPECT_NEAR(max_h - min_h, 4 * EIGEN_PI, 1e-9);
 
   // hide: the hidden hand is behind the back, near the spine.
   const auto hide = run("hide");
@@ -107,7 +106,7 @@ TEST(SimScenario, ScriptsDoWhatTheirNamesSay) {
     const auto s = sim::forward_kinematics(body, a.pose);
     const Eigen::Vector3d fwd(std::sin(a.pose.heading), 0, std::cos(a.pose.heading));
     const Eigen::Vector3d rel = s[JointId::LeftHand].position - s[JointId::Torso].position;
-    if (std::abs(a.pose.left_arm.elbow_flex - kPi / 2) < 1e-6) {
+    if (std::abs(a.pose.left_arm.elbow_flex - EIGEN_PI / 2) < 1e-6) {
       EXPECT_LT(rel.dot(fwd), -0.1);
       EXPECT_LT(std::abs(rel.x()), 0.12);
       checked = true;
@@ -176,10 +175,10 @@ TEST(SimSensor, FieldOfViewRangeAndOcclusion) {
   EXPECT_TRUE(v.in_view({0, 1.2, 0}));
   EXPECT_FALSE(v.in_view({0, 1.2, 1.5}));   // 0.5 m: too close
   EXPECT_FALSE(v.in_view({0, 1.2, -2.5}));  // 4.5 m: too far
-  const double half_h = 57.0 / 2 * kPi / 180;
+  const double half_h = 57.0 / 2 * EIGEN_PI / 180;
   EXPECT_TRUE(v.in_view({2.0 * std::tan(half_h) - 0.01, 1.2, 0}));
   EXPECT_FALSE(v.in_view({2.0 * std::tan(half_h) + 0.01, 1.2, 0}));
-  const double half_v = 43.0 / 2 * kPi / 180;
+  const double half_v = 43.0 / 2 * EIGEN_PI / 180;
   EXPECT_FALSE(v.in_view({0, 1.2 + 2.0 * std::tan(half_v) + 0.01, 0}));
 
   const std::vector<sim::Obstacle> wall{{"wall", Eigen::AlignedBox3d(Eigen::Vector3d(-0.5, 0, 0.9), Eigen::Vector3d(0.5, 2, 1.0))}};
@@ -194,8 +193,8 @@ TEST(SimSensor, ParsesPosesAndRejectsBadOnes) {
   const auto c = sim::parse_sensor("left:1,1.5,-2,90,10");
   EXPECT_EQ(c.id, "left");
   EXPECT_EQ(c.position, Eigen::Vector3d(1, 1.5, -2));
-  EXPECT_NEAR(c.yaw, kPi / 2, 1e-12);
-  EXPECT_NEAR(c.pitch, 10 * kPi / 180, 1e-12);
+  EXPECT_NEAR(c.yaw, EIGEN_PI / 2, 1e-12);
+  EXPECT_NEAR(c.pitch, 10 * EIGEN_PI / 180, 1e-12);
   for (const char* bad : {"1,2,3,4", "x:1,2,3", "x:1,2,three,4", "x:1,2,3,4,5,6", "x:1,2,3,nan"}) {
     EXPECT_THROW(sim::parse_sensor(bad), std::invalid_argument) << bad;
   }
@@ -267,10 +266,10 @@ TEST(SimTracker, BackToTheSensorFlipsLeftAndRight) {
     const Eigen::Vector3d reported_left = world_from_sensor * e.skeleton[JointId::LeftShoulder].position;
     const bool swapped = (reported_left - truth[JointId::RightShoulder].position).norm() <
                          (reported_left - truth[JointId::LeftShoulder].position).norm();
-    if (angle > 160 * kPi / 180) {
+    if (angle > 160 * EIGEN_PI / 180) {
       ++back_frames;
       flipped += swapped ? 1 : 0;
-    } else if (angle < 20 * kPi / 180) {
+    } else if (angle < 20 * EIGEN_PI / 180) {
       ++front_frames;
       front_flipped += swapped ? 1 : 0;
     }
@@ -528,7 +527,7 @@ TEST(SimShift, PeopleComeWorkAndLeaveAndEveryDepartureIsAnEvent) {
 
 // Layouts of a cell: every sensor 2 m from the centre, looking at it.
 TEST(SimSensors, LayoutsPlaceEverySensorRoundTheCellLookingAtIt) {
-  const auto angle_of = [](const sim::SensorConfig& s) { return std::atan2(s.position.x(), s.position.z()) * 180.0 / kPi; };
+  const auto angle_of = [](const sim::SensorConfig& s) { return std::atan2(s.position.x(), s.position.z()) * 180.0 / EIGEN_PI; };
   for (const auto& name : sim::layout_names()) {
     SCOPED_TRACE(name);
     const int n = name == "corners" ? 4 : 5;
@@ -566,7 +565,7 @@ TEST(SimBump, ASensorKnockedOutOfPlaceSeesFromWhereItNowIs) {
   const auto ea = a.advance(20), eb = b.advance(20);
   ASSERT_EQ(ea.size(), eb.size());
   sim::SensorConfig moved = plain.sensors[1];
-  moved.yaw += 5 * kPi / 180;
+  moved.yaw += 5 * EIGEN_PI / 180;
   moved.position += 0.1 * (plain.sensors[1].world_from_sensor().linear() * Eigen::Vector3d::UnitX());
   const sim::SensorView old_view(plain.sensors[1]), new_view(moved);
   std::size_t before = 0, after = 0;

@@ -25,6 +25,36 @@ class UsageError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+namespace detail {
+template <class... Errors>
+struct AsUsage;
+template <>
+struct AsUsage<> {
+  template <class F>
+  static auto run(F& f) {
+    return f();
+  }
+};
+template <class E, class... Rest>
+struct AsUsage<E, Rest...> {
+  template <class F>
+  static auto run(F& f) {
+    try {
+      return AsUsage<Rest...>::run(f);
+    } catch (const E& e) {
+      throw UsageError(e.what());
+    }
+  }
+};
+}  // namespace detail
+
+// Runs f(); a library error of one of the types Errors is the user's input:
+// rethrown as a UsageError (exit 2) with its message.
+template <class... Errors, class F>
+auto user_input(F&& f) {
+  return detail::AsUsage<Errors...>::run(f);
+}
+
 // A batch of input files in which one bad file does not stop the others: each
 // problem is printed on stderr as it is met ("error: FILE:LINE: what"), the
 // rest is processed, and the command exits 2 (bad input) at the end.

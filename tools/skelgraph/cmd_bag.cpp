@@ -17,7 +17,7 @@
 namespace skelgraph::cli {
 
 namespace {
-using bag_cmd::user_input;
+using bag_cmd::file_input;
 
 void print_info(const nlohmann::json& d) {
   const auto u = [](const nlohmann::json& v) { return static_cast<unsigned long long>(v.get<std::uint64_t>()); };
@@ -51,7 +51,7 @@ int info(const std::vector<std::string>& files, bool json) {
   nlohmann::json all = nlohmann::json::array();
   bool valid = true;
   for (const auto& f : files) {
-    auto d = user_input([&] { return recording::recording_info(f); });
+    auto d = file_input([&] { return recording::recording_info(f); });
     valid = valid && d["valid"].get<bool>();
     if (!json) print_info(d);
     all.push_back(std::move(d));
@@ -61,7 +61,7 @@ int info(const std::vector<std::string>& files, bool json) {
 }
 
 int recover(const std::string& in, const std::string& out, bool json) {
-  const auto rep = user_input([&] { return mcap::recover(in, out); });
+  const auto rep = file_input([&] { return mcap::recover(in, out); });
   const double lost = rep.input_size > 0 ? 100.0 * static_cast<double>(rep.input_size - rep.bytes_read) / rep.input_size : 0;
   if (json) {
     std::printf("%s\n", nlohmann::json{{"in", in},
@@ -88,7 +88,7 @@ int merge(const std::vector<std::string>& files, const std::string& out_path, mc
   recording::MergeOptions options;
   options.compression = compression;
   options.max_age_ms = max_age_ms;
-  const auto r = user_input([&] {
+  const auto r = file_input([&] {
     try {
       return recording::merge_recordings(files, out_path, options);
     } catch (const recording::MergeError& e) {
@@ -120,7 +120,7 @@ int merge(const std::vector<std::string>& files, const std::string& out_path, mc
 // Runs one component of `kind` with parameters given as text.
 int run_component(GlobalOptions& g, const std::string& kind, const std::vector<runtime::RawParam>& raw,
                   const RunOptions& ro) {
-  return user_input([&] { return run_components(g, {{kind, kind, raw}}, ro); });
+  return file_input([&] { return run_components(g, {{kind, kind, raw}}, ro); });
 }
 
 void add_bag_command(CLI::App& app, GlobalOptions& g, Action& run) {
@@ -221,7 +221,7 @@ void add_bag_command(CLI::App& app, GlobalOptions& g, Action& run) {
            {{"address", v->address, "view"},
             {"port", std::to_string(v->port), "view"},
             {"credentials", v->credentials, "view"}}}};
-      return user_input([&] { return run_components(g, list, r->run); });
+      return file_input([&] { return run_components(g, list, r->run); });
     };
   });
 

@@ -1,6 +1,8 @@
 #pragma once
 // `skelgraph bag`: what its subcommands (cmd_bag*.cpp) share.
 
+#include <utility>
+
 #include "cli.hpp"
 #include "skelgraph/calib/calib_file.hpp"
 #include "skelgraph/mcap/mcap.hpp"
@@ -11,18 +13,9 @@ namespace skelgraph::cli::bag_cmd {
 
 // A bad file is the user's input: exit 2 with what and where.
 template <class F>
-auto user_input(F&& f) {
-  try {
-    return f();
-  } catch (const mcap::McapError& e) {
-    throw UsageError(e.what());
-  } catch (const playback::DataError& e) {
-    throw UsageError(e.what());
-  } catch (const recording::ConvertError& e) {
-    throw UsageError(e.what());
-  } catch (const calib::CalibFileError& e) {
-    throw UsageError(e.what());
-  }
+auto file_input(F&& f) {
+  return cli::user_input<mcap::McapError, playback::DataError, recording::ConvertError, calib::CalibFileError>(
+      std::forward<F>(f));
 }
 
 // bag import, import-bvh and export (cmd_bag_convert.cpp).

@@ -17,7 +17,7 @@ namespace {
 
 int import(playback::Format format, const std::vector<std::string>& files, const playback::ReadOptions& opt,
            const std::string& out, mcap::Compression compression, bool json) {
-  const auto frames = user_input([&] {
+  const auto frames = file_input([&] {
     return recording::import_skeletons(format, files, opt, out, compression, [&](const std::string& f, std::size_t n) {
       if (!json) std::fprintf(stderr, "%s: %zu frames\n", f.c_str(), n);
     });
@@ -34,7 +34,7 @@ struct MocapOptions : recording::MocapImport {
 // Motion capture (BVH) as ground truth on skelgraph/skeleton/truth, alone or
 // added to a copy of a recording (so `eval recording` scores it against the mocap).
 int import_bvh(const MocapOptions& o) {
-  const auto r = user_input([&] { return recording::import_mocap(o); });
+  const auto r = file_input([&] { return recording::import_mocap(o); });
   if (o.json)
     std::printf("%s\n", nlohmann::json{{"out", o.out}, {"truth_frames", r.truth_frames}, {"span_s", r.span_s}, {"copied", r.copied},
                                        {"time_offset_s", r.time_offset_s}}
@@ -52,7 +52,7 @@ int export_scene(const std::string& file, const std::string& out, const std::str
   mcap::WriterOptions w;
   w.compression = *mcap::compression_from_name(compression);
   Progress progress(!json);
-  const auto r = user_input([&] {
+  const auto r = file_input([&] {
     return scene::export_scene(file, out, {}, w, [&](std::uint64_t done, std::uint64_t total) {
       progress("copied " + std::to_string(done) + "/" + std::to_string(total) + " messages", done >= total);
     });
@@ -90,7 +90,7 @@ int export_scene(const std::string& file, const std::string& out, const std::str
 
 // Skeletons to CSV: generic (lossless, reads back) or plain numeric columns.
 int export_bag(const std::string& file, const std::string& format, const std::string& dir, bool json) {
-  const auto files = user_input([&] {
+  const auto files = file_input([&] {
     return recording::export_skeletons(file, format == "generic" ? recording::SkeletonCsv::Generic : recording::SkeletonCsv::Columns,
                                        dir);
   });

@@ -24,16 +24,6 @@ struct FileOptions : eval::RecordingOptions {
   bool json = false;
 };
 
-// The library's errors are the user's input: exit 2 with the message.
-template <class F>
-auto user_input(F&& f) {
-  try {
-    return f();
-  } catch (const eval::RecordingError& e) {
-    throw UsageError(e.what());
-  }
-}
-
 // A long recording's progress on stderr.
 eval::ProgressFn progress_of(Progress& p) {
   return [&p](const std::string& text) { p(text); };
@@ -43,7 +33,8 @@ eval::ProgressFn progress_of(Progress& p) {
 // has one; bone-length steadiness and completeness either way.
 int eval_file(const FileOptions& o) {
   Progress progress;
-  const auto scored = user_input([&] { return eval::score_recording(o.file, o, !o.report_dir.empty(), progress_of(progress)); });
+  const auto scored = user_input<eval::RecordingError>(
+      [&] { return eval::score_recording(o.file, o, !o.report_dir.empty(), progress_of(progress)); });
   progress.done(false);
   const auto& in = scored.in;
   const auto& r = scored.result;
@@ -123,7 +114,8 @@ int eval_live(const LiveOptions& o, GlobalOptions& g) {
 // skelgraph/skeleton/fused (sensor_id "fused", or "fused_<method>" for several).
 int fuse_file(const FileOptions& o) {
   Progress progress;
-  const auto j = user_input([&] { return eval::fuse_recording(o.file, o.out, o, progress_of(progress)); });
+  const auto j =
+      user_input<eval::RecordingError>([&] { return eval::fuse_recording(o.file, o.out, o, progress_of(progress)); });
   progress.done(false);
   if (o.json) {
     std::printf("%s\n", j.dump(2).c_str());
@@ -140,7 +132,7 @@ int fuse_file(const FileOptions& o) {
 RecordingReport eval_recording_section(const std::string& file, const std::string& report_dir, const std::string& title) {
   FileOptions o;
   o.file = file;
-  const auto scored = user_input([&] { return eval::score_recording(o.file, o, true); });
+  const auto scored = user_input<eval::RecordingError>([&] { return eval::score_recording(o.file, o, true); });
   std::filesystem::create_directories(report_dir);
   return {scored.summary, eval::report_section(report_dir, "live", title, scored.result, "right_hand")};
 }

@@ -18,16 +18,6 @@ namespace {
 
 using namespace runtime::security;
 
-// The library's refusals are the user's input: exit 2 with the message.
-template <class F>
-auto user_input(F&& f) {
-  try {
-    return f();
-  } catch (const CredentialsError& e) {
-    throw UsageError(e.what());
-  }
-}
-
 std::string joined(const std::vector<std::string>& v, const char* sep = "+") {
   std::string out;
   for (const auto& s : v) out += (out.empty() ? "" : sep) + s;
@@ -41,8 +31,8 @@ struct InitOpts : CellSpec {
 };
 
 int init(const InitOpts& o) {
-  const auto hosts = user_input([&] { return hosts_of(o); });
-  const auto out = user_input([&] { return make_cell_credentials(o.dir, o); });
+  const auto hosts = user_input<CredentialsError>([&] { return hosts_of(o); });
+  const auto out = user_input<CredentialsError>([&] { return make_cell_credentials(o.dir, o); });
   const std::string dir = out["directory"];
   if (o.json) {
     std::printf("%s\n", out.dump().c_str());
@@ -76,7 +66,7 @@ struct ViewerOpts : ViewerCertSpec {
 
 // `security viewer`: the viewer's server certificate (--server) or a person's client certificate (--person).
 int viewer_cert(const ViewerOpts& o) {
-  const auto out = user_input([&] { return make_viewer_certificate(o.dir, o); });
+  const auto out = user_input<CredentialsError>([&] { return make_viewer_certificate(o.dir, o); });
   const bool server = !o.server.empty();
   const std::string name = out["name"], dir = std::filesystem::absolute(o.dir).string();
   const int days = out["days"];
@@ -98,7 +88,7 @@ int viewer_cert(const ViewerOpts& o) {
 
 // `security token`: a viewer token for a person (printed once; only its hash is kept), or --revoke NAME.
 int viewer_token(const ViewerOpts& o) {
-  const auto out = user_input([&] { return runtime::security::viewer_token(o.dir, o.person, o.revoke, o.days); });
+  const auto out = user_input<CredentialsError>([&] { return runtime::security::viewer_token(o.dir, o.person, o.revoke, o.days); });
   const std::string file = tokens_file(o.dir);
   if (o.json) {
     std::printf("%s\n", out.dump().c_str());
