@@ -43,3 +43,55 @@ TEST(Skeleton, MessageConversionKeepsEverything) {
     EXPECT_EQ(back.joints[i].sensor_mask, s.joints[i].sensor_mask);
   }
 }
+
+// --- A source's stamps onto the receive clock ---
+
+#include <random>
+
+#include "skelgraph/skeleton/stamp_map.hpp"
+
+// A source whose clock runs twice as fast and 40 s ahead, delivering its
+// 30 Hz frames in bursts (the publisher wakes every 5-300 ms and sends all
+// it has): mapped stamps keep the frames' spacing on the receive clock.
+TEST(StampMap, KeepsTheSpacingOfFramesDeliveredInBursts) {
+  skeleton::StampMap m;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> wake(0.005, 0.3);
+  const std::int64_t epoch = 1'700'000'000'000'000'000;
+  double next_wake = 0;
+  std::vector<std::pair<double, std::int64_t>> frames;  // (capture time on the receive clock, receive ns)
+  for (int f = 0; f < 900; ++f) {
+    const double t = f / 30.0;
+    while (next_wake < t) next_wake += wake(rng);
+    const auto receive = epoch + static_cast<std::int64_t>(std::llround(next_wake * 1e9));
+    const auto stamp = epoch + 40'000'000'000 + static_cast<std::int64_t>(std::llround(2 * t * 1e9));
+    m.add(stamp, receive);
+    frames.emplace_back(t, stamp);
+  }
+  EXPECT_NEAR(m.rate(), 0.5, 0.005);
+  // The last 20 s (the window): each frame 33.3 ms after the one before, within 1 ms; by receive
+  // time alone some come 0 ms and some 300 ms apart.
+  double worst_ms = 0;
+  for (std::size_t i = frames.size() - 590; i < frames.size(); ++i) {
+    const double gap_ms = static_cast<double>(m.to_receive(frames[i].second) - m.to_receive(frames[i - 1].second)) * 1e-6;
+    worst_ms = std::max(worst_ms, std::abs(gap_ms - 1000.0 / 30));
+  }
+  EXPECT_LT(worst_ms, 1.0);
+  // On the receive clock, no earlier than the capture and within the mean burst delay (about 75 ms).
+  const double lag_ms = static_cast<double>(m.to_receive(frames.back().second) - epoch) * 1e-6 - frames.back().first * 1e3;
+  EXPECT_GT(lag_ms, 20.0);
+  EXPECT_LT(lag_ms, 150.0);
+  EXPECT_EQ(m.restarts(), 0u);
+}
+
+// A source that restarts (its stamps jump back) is fitted again from its new frames.
+TEST(StampMap, AStampThatJumpsStartsTheFitAgain) {
+  skeleton::StampMap m;
+  EXPECT_EQ(m.to_receive(1234), 1234);  // nothing known: the stamp itself
+  for (int f = 0; f < 100; ++f) m.add(5'000'000'000 + f * 33'000'000LL, 1'000'000'000 + f * 33'000'000LL);
+  EXPECT_EQ(m.to_receive(5'000'000'000), 1'000'000'000);
+  for (int f = 0; f < 10; ++f) m.add(f * 33'000'000LL, 4'400'000'000 + f * 33'000'000LL);
+  EXPECT_EQ(m.restarts(), 1u);
+  EXPECT_EQ(m.size(), 10u);
+  EXPECT_EQ(m.to_receive(0), 4'400'000'000);
+}

@@ -32,16 +32,22 @@ void DriftMonitor::set_pose(const std::string& sensor, const Eigen::Isometry3d& 
   d.erase(std::remove_if(d.begin(), d.end(), [&](const TimedSkeleton& x) { return x.t_ns < now_ns_; }), d.end());
 }
 
-void DriftMonitor::add(const std::string& sensor, std::int64_t t_ns, const skeleton::Skeleton& s) {
-  data_[sensor].push_back({t_ns, s});
+void DriftMonitor::add(const std::string& sensor, std::int64_t receive_ns, const skeleton::Skeleton& s) {
+  auto& d = data_[sensor];
+  // One sample a frame (the people of a frame share its stamp).
+  if (s.stamp_ns != 0 && (d.empty() || d.back().skeleton.stamp_ns != s.stamp_ns)) clocks_[sensor].add(s.stamp_ns, receive_ns);
+  d.push_back({receive_ns, s});
 }
 
 std::vector<TimedSkeleton> DriftMonitor::window(const std::string& sensor, std::int64_t from_ns) const {
   std::vector<TimedSkeleton> out;
   const auto it = data_.find(sensor);
   if (it == data_.end()) return out;
-  for (const auto& x : it->second)
-    if (x.t_ns >= from_ns && x.t_ns <= now_ns_) out.push_back(x);
+  const auto clock = clocks_.find(sensor);
+  for (const auto& x : it->second) {
+    const std::int64_t t = x.skeleton.stamp_ns != 0 && clock != clocks_.end() ? clock->second.to_receive(x.skeleton.stamp_ns) : x.t_ns;
+    if (t >= from_ns && t <= now_ns_) out.push_back({t, x.skeleton});
+  }
   std::sort(out.begin(), out.end(), [](const TimedSkeleton& x, const TimedSkeleton& y) { return x.t_ns < y.t_ns; });
   return out;
 }
@@ -126,7 +132,10 @@ std::vector<SensorDrift> DriftMonitor::sensors() const {
       if (!p.has_baseline || !poses_.count(p.a) || !poses_.count(p.b)) continue;
       const bool mine = p.a == id || p.b == id;
       if (!mine) {
-        other_fine = other_fine || !is_off(p);
+        // Within the alarm now, not merely unconfirmed: when a sensor moves, its pairs go off one
+        // evaluation apart, and a third sensor whose other pair is off by noise must not be taken
+        // for it while the moved one's pair is still confirming.
+        other_fine = other_fine || p.streak == 0;
         continue;
       }
       if (!p.evaluated) continue;

@@ -10,13 +10,16 @@
 // when its offset has moved from the baseline by `alarm_cm` (at the person:
 // a sensor 2.5 m away turned by 3 degrees moves them 13 cm) for `confirm`
 // evaluations in a row. A sensor has drifted when every pair it is in is off
-// while some pair without it is not; with two sensors both are reported (two
+// while some pair without it is within the alarm; with two sensors both are reported (two
 // cannot tell which one moved). A sensor reported stays reported until it
 // gets a new pose. A rigid fit over a few seconds of one person
 // cannot tell a turn from a shift (its rotation wanders by degrees), so the
 // offset at the person is what is watched and what the refined pose corrects.
 //
-// Time is passed in (the receive clock); no DDS.
+// Time is passed in (the receive clock); no DDS. Skeletons are paired at
+// their capture stamps mapped onto the receive clock (skeleton::StampMap,
+// one per sensor): a sensor whose frames arrive in bursts, as they do from a
+// busy host, is still paired with the others' poses of the same moment.
 
 #include <Eigen/Geometry>
 #include <cstdint>
@@ -26,6 +29,7 @@
 #include <vector>
 
 #include "skelgraph/calib/skeleton_calib.hpp"
+#include "skelgraph/skeleton/stamp_map.hpp"
 
 namespace skelgraph::calib {
 
@@ -77,8 +81,10 @@ class DriftMonitor {
   // A sensor's calibrated pose (world_from_sensor); a new pose restarts the
   // baselines of its pairs.
   void set_pose(const std::string& sensor, const Eigen::Isometry3d& world_from_sensor);
-  // A raw skeleton in the sensor's frame, at t_ns.
-  void add(const std::string& sensor, std::int64_t t_ns, const skeleton::Skeleton& s);
+  // A raw skeleton in the sensor's frame, received at receive_ns; its
+  // stamp_ns (the capture, on the sensor's clock; 0: not given, the receive
+  // time is taken) places it in time.
+  void add(const std::string& sensor, std::int64_t receive_ns, const skeleton::Skeleton& s);
   // Evaluates the windows ending at now_ns (call about once a second).
   void update(std::int64_t now_ns);
 
@@ -98,7 +104,8 @@ class DriftMonitor {
 
   DriftOptions o_;
   std::map<std::string, Eigen::Isometry3d> poses_;
-  std::map<std::string, std::deque<TimedSkeleton>> data_;
+  std::map<std::string, std::deque<TimedSkeleton>> data_;   // t_ns: the receive time
+  std::map<std::string, skeleton::StampMap> clocks_;         // each sensor's stamps onto the receive clock
   std::vector<PairDrift> pairs_;
   std::vector<PairState> state_;   // parallel to pairs_
   std::map<std::string, std::int64_t> since_;  // sensor -> first reported
