@@ -27,7 +27,7 @@ wait_for_match() {
   local file=$1 pattern=$2 deadline=$((SECONDS + $3))
   while [ "$SECONDS" -lt "$deadline" ]; do
     grep -q -- "$pattern" "$file" 2>/dev/null && return 0
-    python3 -c 'import time; time.sleep(0.05)'
+    sleep 0.05
   done
   grep -q -- "$pattern" "$file" 2>/dev/null
 }
@@ -39,7 +39,7 @@ wait_for_count() {
     c=$(grep -c -- "$pattern" "$file" 2>/dev/null || true)
     [ "${c:-0}" -ge "$n" ] && return 0
     [ "$SECONDS" -lt "$deadline" ] || return 1
-    python3 -c 'import time; time.sleep(0.1)'
+    sleep 0.1
   done
 }
 
@@ -49,7 +49,7 @@ wait_until() {
   while :; do
     "$@" >/dev/null 2>&1 && return 0
     [ "$SECONDS" -lt "$deadline" ] || return 1
-    python3 -c 'import time; time.sleep(0.2)'
+    sleep 0.2
   done
 }
 

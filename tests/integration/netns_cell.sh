@@ -102,7 +102,7 @@ link() {
   echo "$*" >&7
   for _ in $(seq 50); do
     [ "$(grep -c "^ok" "$WORK/link.out" || true)" -gt "$before" ] && return 0
-    python3 -c 'import time; time.sleep(0.02)'
+    sleep 0.02
   done
   fail "lossy_link did not take '$*': $(tail -2 "$WORK/link.out")"
 }
@@ -116,7 +116,7 @@ link_stats() {
       grep "^{" "$WORK/link.out" | tail -1 >"$1"
       return 0
     fi
-    python3 -c 'import time; time.sleep(0.02)'
+    sleep 0.02
   done
   fail "lossy_link gave no stats"
 }

@@ -188,7 +188,7 @@ for line in open(sys.argv[1]):
 sys.exit(0 if k == len(want) else 1)
 PY
 }
-wait_verdicts() { local deadline=$((SECONDS + 60)); until verdicts_show "$@"; do [ "$SECONDS" -lt "$deadline" ] || return 1; python3 -c 'import time; time.sleep(0.2)'; done; }
+wait_verdicts() { local deadline=$((SECONDS + 60)); until verdicts_show "$@"; do [ "$SECONDS" -lt "$deadline" ] || return 1; sleep 0.2; done; }
 wait_verdicts "RUN:" || fail "the monitor never ran with the worker 8 m away: $(tail -2 "$WORK/gs_verdicts.jsonl")"
 "$PUBLISH_GESTURE" 1 stop 2>/dev/null || fail "the stop gesture was not published"
 wait_verdicts "RUN:" "PROTECTIVE_STOP:stop gesture by person 7" || fail "no stop for the gesture: $(tail -2 "$WORK/gs_verdicts.jsonl")"
