@@ -100,10 +100,7 @@ link() {
   local before
   before=$(grep -c "^ok" "$WORK/link.out" || true)
   echo "$*" >&7
-  for _ in $(seq 50); do
-    [ "$(grep -c "^ok" "$WORK/link.out" || true)" -gt "$before" ] && return 0
-    sleep 0.02
-  done
+  wait_for_count "$WORK/link.out" "^ok" $((before + 1)) 15 && return 0
   fail "lossy_link did not take '$*': $(tail -2 "$WORK/link.out")"
 }
 
@@ -111,12 +108,9 @@ link_stats() {
   local before
   before=$(grep -c "^{" "$WORK/link.out" || true)
   echo stats >&7
-  for _ in $(seq 50); do
-    if [ "$(grep -c "^{" "$WORK/link.out" || true)" -gt "$before" ]; then
-      grep "^{" "$WORK/link.out" | tail -1 >"$1"
-      return 0
-    fi
-    sleep 0.02
-  done
+  if wait_for_count "$WORK/link.out" "^{" $((before + 1)) 15; then
+    grep "^{" "$WORK/link.out" | tail -1 >"$1"
+    return 0
+  fi
   fail "lossy_link gave no stats"
 }
