@@ -1,5 +1,6 @@
 #include "skelgraph/runtime/graph.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <map>
 #include <set>
@@ -200,9 +201,54 @@ void Graph::add_all(const std::vector<ResolvedComponent>& components) {
   for (const auto& c : components) add(c.name, c.kind, c.params);
 }
 
+std::vector<std::string> Graph::await_matches(std::chrono::milliseconds timeout) const {
+  struct End {
+    const std::string* component;
+    std::shared_ptr<EndpointCounter> counter;
+  };
+  std::vector<End> ends;
+  for (const auto& n : nodes_) {
+    for (auto& c : n->context->counters()) ends.push_back({&n->name, std::move(c)});
+  }
+  // What each endpoint must have matched inside the graph: the other side's
+  // endpoints on its topic whose QoS fit (a writer offers at least what a reader asks).
+  std::vector<std::size_t> want(ends.size(), 0);
+  for (std::size_t i = 0; i < ends.size(); ++i) {
+    const auto& a = *ends[i].counter;
+    for (const auto& e : ends) {
+      const auto& b = *e.counter;
+      if (b.topic != a.topic || b.is_output == a.is_output) continue;
+      const auto& w = a.is_output ? a : b;
+      const auto& r = a.is_output ? b : a;
+      if ((w.reliable || !r.reliable) && (w.transient_local || !r.transient_local)) ++want[i];
+    }
+  }
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  std::vector<std::string> missing;
+  for (std::size_t i = 0; i < ends.size(); ++i) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    if (ends[i].counter->wait_matched(want[i], std::max(left, std::chrono::milliseconds(0)))) continue;
+    missing.push_back(*ends[i].component + (ends[i].counter->is_output ? " writing " : " reading ") +
+                      ends[i].counter->topic + " (" + std::to_string(ends[i].counter->matched()) + " of " +
+                      std::to_string(want[i]) + " matched)");
+  }
+  return missing;
+}
+
 void Graph::start() {
   if (started_) return;
   started_ = true;
+  // Components start once they hear each other: a sync session, say, begins
+  // only when every fusion component's reader has matched its writer (on a
+  // busy machine discovery can take seconds, and volatile ticks sent before
+  // a match never reach that reader).
+  const auto missing = await_matches(kMatchWait);
+  if (!missing.empty()) {
+    std::string list;
+    for (const auto& m : missing) list += (list.empty() ? "" : "; ") + m;
+    std::fprintf(stderr, "graph: starting although, after %lld s, DDS has not matched inside the graph: %s\n",
+                 static_cast<long long>(kMatchWait.count() / 1000), list.c_str());
+  }
   for (auto& n : nodes_) start_node(n.get());
 }
 

@@ -94,6 +94,8 @@ WriterBase::WriterBase(Context& ctx, const std::string& topic, dds::TopicDataTyp
   type_ = ctx.participant().find_type(t.get_type_name());
   keyed_ = type_->m_isGetKeyDefined;
   counter_ = ctx.add_counter(topic, true);
+  counter_->reliable = qos.reliability == Reliability::Reliable;
+  counter_->transient_local = qos.durability == Durability::TransientLocal;
   listener_->counter = counter_;
   dds::DataWriterQos wq = dds::DATAWRITER_QOS_DEFAULT;
   apply(qos, keyed_, wq);
@@ -296,6 +298,8 @@ ReaderBase::ReaderBase(Context& ctx, const std::string& topic, dds::TopicDataTyp
   state_->gone = std::move(gone);
   state_->clock = ctx.clock_ptr();
   state_->counter = ctx.add_counter(topic, false);
+  state_->counter->reliable = qos.reliability == Reliability::Reliable;
+  state_->counter->transient_local = qos.durability == Durability::TransientLocal;
   dds::DataReaderQos rq = dds::DATAREADER_QOS_DEFAULT;
   apply(qos, state_->type->m_isGetKeyDefined, rq);
   dds::StatusMask mask = dds::StatusMask::data_available();

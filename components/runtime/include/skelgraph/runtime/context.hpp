@@ -32,6 +32,10 @@ namespace skelgraph::runtime {
 struct EndpointCounter {
   std::string topic;
   bool is_output = false;
+  // The endpoint's QoS as far as matching goes: a reader matches a writer that
+  // offers at least what it asks (reliable, transient local).
+  bool reliable = true;
+  bool transient_local = false;
   std::atomic<std::uint64_t> count{0};
   std::atomic<std::uint64_t> dropped{0};    // outputs: writes DDS refused; inputs: samples rejected or lost
   std::atomic<std::uint64_t> instances{0};  // keyed outputs: instances written and not yet disposed

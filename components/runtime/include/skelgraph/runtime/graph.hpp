@@ -42,7 +42,15 @@ class Graph {
   Component& add(const std::string& name, const std::string& kind, const Params& params);
   void add_all(const std::vector<ResolvedComponent>& components);
 
-  void start();  // starts every executor, then on_start() of each component
+  // Waits (at most kMatchWait) until DDS has matched every reader and writer
+  // of the graph with their counterparts inside it, then starts every
+  // executor and on_start() of each component. What did not match in time is
+  // named on stderr.
+  void start();
+  static constexpr std::chrono::milliseconds kMatchWait{10000};
+  // The endpoints not matched with all their counterparts in the graph within
+  // `timeout`, as "component reading topic (n of m matched)".
+  std::vector<std::string> await_matches(std::chrono::milliseconds timeout) const;
   void stop();   // on_shutdown() of each (reverse order), then stops executors; idempotent
 
   // A secure peer not authenticated after this long is stuck (a handshake takes 1-2 s).
