@@ -98,8 +98,12 @@ check(expected <= streams, f"streams drawn: {sorted(streams)}, expected {sorted(
 u = page["uncertainty"]
 check(u["before"] > 0 and u["hidden"] == 0 and u["restored"] > 0, f"uncertainty layer toggle: {u}")
 fused_spheres = [s for snap in page["snapshots"] for s in snap["list"] if s["kind"] == "fused"]
-check(all(0 < s["uncertainty"] <= s["joints"] and 0.005 < s["radius_95_max"] < 1.0 for s in fused_spheres),
-      f"fused skeletons without their 95 % spheres, or implausible radii: {fused_spheres[:3]}")
+# Radii in metres, at most the cell's size: a unit slip (mm) or a lost covariance fails. Not tighter: the
+# fuser's own 95 % radius of an inferred joint reaches 1.0 m in the walk's loop and 1.6 m at a busy start
+# (skelgraph topic echo skelgraph/skeleton/fused on this launch, 2026-12-07).
+bad_spheres = [s for s in fused_spheres if not (0 < s["uncertainty"] <= s["joints"] and 0.005 < s["radius_95_max"] < 3.0)]
+check(fused_spheres and not bad_spheres,
+      f"fused skeletons without their 95 % spheres, or implausible radii: {len(bad_spheres)} of {len(fused_spheres)}, {bad_spheres[:3]}")
 check(all(s["uncertainty"] == 0 for snap in page["snapshots"] for s in snap["list"] if s["kind"] != "fused"),
       "raw or truth skeletons drawn with uncertainty spheres")
 t = page.get("toggle")
