@@ -25,9 +25,11 @@ try {
   const page = await browser.newPage({ viewport: { width: 1280, height: 800 } });
   page.on('console', (m) => { if (m.type() === 'error') out.console_errors.push(m.text()); });
   page.on('pageerror', (e) => out.page_errors.push(String(e)));
-  await page.goto(url);
+  // The page's own condition below is what counts: not the 'load' event, which a suite at -j6
+  // beside the viewer once kept from firing for the default 30 s.
+  await page.goto(url, { waitUntil: 'domcontentloaded', timeout: 60000 });
   await page.waitForFunction(() => window.skelgraphViewer && window.skelgraphViewer.framesDrawn > 10, null,
-                             { timeout: 30000 });
+                             { timeout: 60000 });
   const stats = () => page.evaluate(() => JSON.parse(JSON.stringify(window.skelgraphViewer)));
 
   // Frame rate: frames received and drawn over SECONDS.

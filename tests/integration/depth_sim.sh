@@ -30,7 +30,10 @@ assert sim["raw_published"] == 0 and sim["depth_published"] > 300, sim
 trk = rep["depth_tracker"]["details"]["sensors"]
 for s in ("sensor1", "sensor2"):
     t = trk[s]
-    assert t["images"] > 100 and t["skeletons"] >= 0.95 * t["images"], (s, t)   # the person in nearly every image
+    # The tracker takes the newest image when it is free, so how many it tracks before the
+    # two pointing events is its speed (62 a sensor at 73 ms an image, a suite at -j6 beside it;
+    # about 150 idle): at least 40, the person in nearly every one.
+    assert t["images"] >= 40 and t["skeletons"] >= 0.95 * t["images"], (s, t)
     assert t["skeletons"] <= t["images"], (s, t)                              # and nobody else
     assert t["people_started"] <= 2, (s, t)
 events = [json.loads(l)["data"] for l in open(sys.argv[2]) if l.strip()]
