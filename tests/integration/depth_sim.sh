@@ -32,7 +32,7 @@ for s in ("sensor1", "sensor2"):
     t = trk[s]
     # The tracker takes the newest image when it is free, so how many it tracks before the
     # two pointing events is its speed (62 a sensor at 73 ms an image, a suite at -j6 beside it;
-    # about 150 idle): at least 40, the person in nearly every one.
+    # 366 and 362 at 7-9 ms when run alone): at least 40, the person in nearly every one.
     assert t["images"] >= 40 and t["skeletons"] >= 0.95 * t["images"], (s, t)
     assert t["skeletons"] <= t["images"], (s, t)                              # and nobody else
     assert t["people_started"] <= 2, (s, t)
